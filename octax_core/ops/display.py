@@ -1,0 +1,63 @@
+"""The display: 00E0 and DXYN on the packed screen.
+
+A screen row is 64 pixels in two uint32 words, x = 0 in bit 31 of word 0. A sprite byte drawn
+at column x is that byte shifted into the 64-bit row, so a draw is shifts, an AND for the
+collision test and an XOR, over the rows the sprite covers.
+"""
+
+from __future__ import annotations
+
+import jax
+import jax.numpy as jnp
+
+from octax_core.ops import Context
+from octax_core.state import SCREEN_HEIGHT
+
+
+def _shl(value, amount):
+    # XLA defines shifts by >= 32 (and by negative amounts, seen as huge unsigned) as 0.
+    return value << amount.astype(jnp.uint32)
+
+
+def _shr(value, amount):
+    return value >> amount.astype(jnp.uint32)
+
+
+def sprite_rows(sprite: jax.Array, x: jax.Array, clipping: bool) -> jax.Array:
+    """(rows,) sprite bytes at column x (0..63) -> (rows, 2) uint32 row words."""
+    byte = sprite.astype(jnp.uint32)
+    shift = 56 - x  # left shift of the byte within the 64-bit row; -7..56
+    low_word = _shl(byte, shift) | _shr(byte, -shift)
+    high_word = _shl(byte, shift - 32) | _shr(byte, 32 - shift)
+    if not clipping:  # pixels past x = 63 come back at x = 0
+        high_word = high_word | _shl(byte, 32 + shift)
+    return jnp.stack([high_word, low_word], axis=-1)
+
+
+def sprite_mask(aligned, x, y, height, clipping: bool) -> jax.Array:
+    """The (32, 2) XOR mask of a `height`-row sprite at (x, y); all zero when height is 0.
+
+    Args:
+        aligned: the bytes at addresses I - y + r for r = 0..31 (and 32..63 without clipping),
+            so that screen row r >= y shows sprite row r - y with no gather.
+        x, y: the sprite's top-left corner, already reduced to 0..63 and 0..31.
+        height: rows to draw, 0..15.
+        clipping: cut at the bottom edge instead of wrapping to the top (static).
+    """
+    offset = jnp.arange(SCREEN_HEIGHT, dtype=jnp.int32) - y  # sprite row shown on each screen row
+    if clipping:
+        covered, row_bytes = (offset >= 0) & (offset < height), aligned[:SCREEN_HEIGHT]
+    else:  # rows above y show the sprite rows that wrapped past the bottom
+        covered = (offset & (SCREEN_HEIGHT - 1)) < height
+        row_bytes = jnp.where(offset >= 0, aligned[:SCREEN_HEIGHT], aligned[SCREEN_HEIGHT:])
+    return jnp.where(covered[:, None], sprite_rows(row_bytes, x, clipping), jnp.uint32(0))
+
+
+def op_00e0(c: Context) -> dict:
+    """CLS."""
+    return {"clear": jnp.bool_(True)}
+
+
+def op_dxyn(c: Context) -> dict:
+    """DRW Vx, Vy, n: XOR an n-row sprite from [I]; VF = collision."""
+    return {"vf": c.collision.astype(jnp.int32)}

@@ -1,0 +1,71 @@
+"""Quirk profiles: the behaviours on which CHIP-8 interpreters disagree.
+
+Field names follow the Timendus quirks test ROM (`5-quirks`), so that its screen reports each
+field by name. Quirks change the traced program, so they live in the frozen `Machine` config,
+never in the state.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from typing import Union
+
+
+@dataclasses.dataclass(frozen=True)
+class Quirks:
+    """One interpreter's answers to the CHIP-8 ambiguities.
+
+    Attributes:
+        vf_reset: 8XY1/8XY2/8XY3 set VF to 0 (COSMAC VIP).
+        memory_increment: FX55/FX65 leave I advanced by X + 1.
+        display_wait: a DXYN waits for the display refresh, so it ends its frame.
+        clipping: sprites are cut at the right and bottom edges instead of wrapping.
+        shift_uses_vy: 8XY6/8XYE shift VY into VX; otherwise VX is shifted in place.
+        jump_uses_vx: BNNN jumps to NNN + VX (X = high nibble of NNN); otherwise NNN + V0.
+    """
+
+    vf_reset: bool
+    memory_increment: bool
+    display_wait: bool
+    clipping: bool
+    shift_uses_vy: bool
+    jump_uses_vx: bool
+
+
+QUIRK_PROFILES: dict[str, Quirks] = {
+    # COSMAC VIP, the original interpreter most classic games were written for.
+    "chip8": Quirks(
+        vf_reset=True,
+        memory_increment=True,
+        display_wait=True,
+        clipping=True,
+        shift_uses_vy=True,
+        jump_uses_vx=False,
+    ),
+    # SUPER-CHIP as modern interpreters (Octo's "schip" setting) run it.
+    "schip": Quirks(
+        vf_reset=False,
+        memory_increment=False,
+        display_wait=False,
+        clipping=True,
+        shift_uses_vy=False,
+        jump_uses_vx=True,
+    ),
+}
+
+
+def resolve_quirks(quirks: Union[str, Quirks]) -> Quirks:
+    """Returns the `Quirks` for a profile name, or `quirks` itself.
+
+    Raises:
+        ValueError: an unknown profile name; the message lists the valid ones.
+        TypeError: neither a name nor a `Quirks`.
+    """
+    if isinstance(quirks, Quirks):
+        return quirks
+    if isinstance(quirks, str):
+        if quirks not in QUIRK_PROFILES:
+            valid = ", ".join(repr(name) for name in QUIRK_PROFILES)
+            raise ValueError(f"unknown quirk profile {quirks!r}; valid profiles: {valid}")
+        return QUIRK_PROFILES[quirks]
+    raise TypeError(f"quirks must be a profile name or a Quirks, got {type(quirks).__name__}")
