@@ -1,0 +1,117 @@
+"""Bad input fails early, with the exception type and a message that names the problem.
+
+docs/machine.md, "Bad input": `Rom` refuses an empty program, one over 3584 bytes and anything
+that is not bytes, a path or a `Rom`; `Machine` refuses an unknown profile name (listing the
+valid ones) and a non-positive `instructions_per_frame`.
+"""
+
+import jax
+import pytest
+
+import octax_core
+from octax_core import Machine, Rom
+
+MAX = 3584  # 4096 - 0x200
+
+
+@pytest.fixture
+def key():
+    return jax.random.key(0)
+
+
+def loaders(key):
+    """Each public way in which a program reaches the machine."""
+    return {
+        "Rom": Rom,
+        "Rom.load": Rom.load,
+        "Machine.boot": lambda data: Machine("chip8").boot(data, key),
+    }
+
+
+@pytest.mark.parametrize("way", ["Rom", "Rom.load", "Machine.boot"])
+def test_empty_rom(way, key):
+    with pytest.raises(ValueError, match=r"(?i)empty"):
+        loaders(key)[way](b"")
+
+
+@pytest.mark.parametrize("way", ["Rom", "Rom.load", "Machine.boot"])
+@pytest.mark.parametrize("size", [MAX + 1, 4096])
+def test_rom_too_large(way, key, size):
+    with pytest.raises(ValueError, match=rf"{size}.*\b{MAX}\b"):
+        loaders(key)[way](bytes(size))
+
+
+@pytest.mark.parametrize("way", ["Rom", "Rom.load", "Machine.boot"])
+def test_largest_and_smallest_roms_load(way, key):
+    for data in (bytes([0x12]), bytes(MAX)):
+        loaders(key)[way](data)
+
+
+@pytest.mark.parametrize("way", ["Rom", "Rom.load", "Machine.boot"])
+@pytest.mark.parametrize("bad", [42, [0x12, 0x00], None, 3.5], ids=["int", "list", "None", "float"])
+def test_not_bytes(way, key, bad):
+    with pytest.raises(TypeError, match=type(bad).__name__):
+        loaders(key)[way](bad)
+
+
+def test_rom_from_a_str_is_a_path_not_data():
+    """A str names a file; it is never taken as program text."""
+    with pytest.raises(TypeError):
+        Rom("\x12\x00")
+
+
+@pytest.mark.parametrize("way", ["Rom.load", "Machine.boot"])
+@pytest.mark.parametrize("as_str", [True, False], ids=["str", "Path"])
+def test_missing_file(way, key, tmp_path, as_str):
+    path = tmp_path / "no-such-rom.ch8"
+    with pytest.raises(FileNotFoundError, match="no-such-rom.ch8"):
+        loaders(key)[way](str(path) if as_str else path)
+
+
+@pytest.mark.parametrize("way", ["Rom.load", "Machine.boot"])
+def test_empty_and_oversized_files(way, key, tmp_path):
+    empty, big = tmp_path / "empty.ch8", tmp_path / "big.ch8"
+    empty.write_bytes(b"")
+    big.write_bytes(bytes(MAX + 1))
+    with pytest.raises(ValueError, match=r"(?i)empty"):
+        loaders(key)[way](empty)
+    with pytest.raises(ValueError, match=rf"{MAX + 1}.*\b{MAX}\b"):
+        loaders(key)[way](big)
+
+
+def test_a_directory_is_not_a_rom(key, tmp_path):
+    with pytest.raises((FileNotFoundError, IsADirectoryError, ValueError)):
+        Machine("chip8").boot(tmp_path, key)
+
+
+@pytest.mark.parametrize("name", ["CHIP8", "chip-8", "xochip", "", "superchip"])
+def test_unknown_profile_lists_valid_ones(name):
+    with pytest.raises(ValueError, match=r"(?s)(?=.*'chip8')(?=.*'schip')") as info:
+        Machine(quirks=name)
+    assert repr(name) in str(info.value)
+
+
+def test_quirks_of_the_wrong_type():
+    with pytest.raises(TypeError, match="int"):
+        Machine(quirks=1)
+
+
+def test_profiles_are_the_documented_ones():
+    assert set(octax_core.QUIRK_PROFILES) == {"chip8", "schip"}
+
+
+@pytest.mark.parametrize("ipf", [0, -1, -11])
+def test_non_positive_instructions_per_frame(ipf):
+    with pytest.raises(ValueError, match=rf"instructions_per_frame.*{ipf}"):
+        Machine("chip8", instructions_per_frame=ipf)
+
+
+@pytest.mark.parametrize("ipf", [1.5, "11", True])
+def test_instructions_per_frame_must_be_an_int(ipf):
+    with pytest.raises((TypeError, ValueError), match="instructions_per_frame"):
+        Machine("chip8", instructions_per_frame=ipf)
+
+
+def test_quirks_need_all_six_fields():
+    with pytest.raises(TypeError):
+        octax_core.Quirks(vf_reset=True)
