@@ -77,3 +77,8 @@ class Chip:
 def chip(jit_execute, jit_run_frames):
     """The builder: chip(program, quirks="chip8", **fields) -> Chip."""
     return functools.partial(Chip, (jit_execute, jit_run_frames))
+
+
+def hexid(value):
+    """Test ids in hex: 8F24-FF-01-01 rather than 36644-255-1-1."""
+    return f"{value:02X}" if isinstance(value, int) and not isinstance(value, bool) else None

@@ -14,10 +14,9 @@ from pathlib import Path
 
 import jax
 import pytest
+from reference import RefMachine, first_difference
 
 import octax_core
-
-from reference import RefMachine, first_difference
 
 SHARED = Path(__file__).resolve().parents[3] / "shared"  # ../shared beside the repo
 ROM_DIRS = (Path(os.environ.get("OCTAX_ROM_DIR", SHARED / "roms" / "octax")), SHARED / "roms" / "test-suite")

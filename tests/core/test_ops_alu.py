@@ -6,15 +6,9 @@ Flags are written after the result, so with x == F the flag is what VF holds aft
 
 import jax
 import pytest
+from chip_builder import NEXT, hexid, quirks
 
 import octax_core
-
-from chip_builder import NEXT, quirks
-
-def hexid(value):
-    """Test ids in hex: 8F24-FF-01-01 rather than 36644-255-1-1."""
-    return f"{value:02X}" if isinstance(value, int) and not isinstance(value, bool) else None
-
 
 PROFILES = ["chip8", "schip"]
 VF_BEFORE = 0x55  # a VF value that no tested flag equals

@@ -7,10 +7,9 @@ docs/machine.md, never from the core's output.
 
 import numpy as np
 import pytest
-
 import screen_text as st
-
 from chip_builder import NEXT, quirks
+
 
 def pack(pixels: np.ndarray) -> np.ndarray:
     """(32, 64) bool -> (32, 2) uint32 as MachineState.screen holds it (x = 0 and x = 32 in bit 31)."""

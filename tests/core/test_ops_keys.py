@@ -3,14 +3,7 @@
 
 import numpy as np
 import pytest
-
-
-from chip_builder import NEXT, SKIPPED, START
-
-def hexid(value):
-    """Test ids in hex: 8F24-FF-01-01 rather than 36644-255-1-1."""
-    return f"{value:02X}" if isinstance(value, int) and not isinstance(value, bool) else None
-
+from chip_builder import NEXT, SKIPPED, START, hexid
 
 NO_KEY = 0xFF
 

@@ -2,9 +2,8 @@
 
 
 import pytest
-
-
 from chip_builder import NEXT, SKIPPED, START, quirks
+
 
 @pytest.mark.parametrize("profile", ["chip8", "schip"])
 def test_fx07_reads_the_delay_timer(chip, profile):

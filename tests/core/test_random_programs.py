@@ -14,10 +14,9 @@ import numpy as np
 import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
+from reference import RefMachine, first_difference
 
 import octax_core
-
-from reference import RefMachine, first_difference
 
 QUIRK_SETS = {
     "chip8": "chip8",

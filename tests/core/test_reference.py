@@ -6,7 +6,6 @@ program, runs it on the reference only, and checks registers, memory and screen 
 
 import numpy as np
 import pytest
-
 from reference import FONT_ADDRESS, NO_KEY, PROFILES, RefMachine, RefQuirks, xorshift32
 
 START_PC = 0x200

@@ -16,10 +16,10 @@ import re
 import jax
 import numpy as np
 import pytest
-
-import octax_core
 import screen_text as st
 from screen_text import CORAX_NO, CORAX_OK, FLAG_ERR, FLAG_OK
+
+import octax_core
 
 SUITE = st.SUITE
 SECOND = 60  # frames

@@ -14,10 +14,9 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 import pytest
+from reference import first_difference
 
 import octax_core
-
-from reference import first_difference
 
 SHARED = Path(__file__).resolve().parents[3] / "shared"
 CASES = [
