@@ -132,7 +132,7 @@ def execute(quirks: Quirks, state: MachineState, keys: jax.Array, stalled=None):
                                     (32 if quirks.clipping else 64,))
     mask = display.sprite_mask(aligned.astype(jnp.int32), c.vx & 63, y,
                                jnp.where(kind == Kind.DRW, fields.n, 0), quirks.clipping)
-    collision = jnp.any((state.screen & mask) != 0)
+    collision = display.collides(state.screen, mask)
     effects[Kind.DRW] = display.op_dxyn(c._replace(collision=collision))
 
     # Registers by lane selects, with VF after Vx; a scatter at x would cost more under vmap.

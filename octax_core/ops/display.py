@@ -15,7 +15,8 @@ from octax_core.state import SCREEN_HEIGHT
 
 
 def _shl(value, amount):
-    # XLA defines shifts by >= 32 (and by negative amounts, seen as huge unsigned) as 0.
+    # XLA defines shifts by >= 32 (and by negative amounts, seen as huge unsigned) as 0, which
+    # is exactly "the byte slid off this word".
     return value << amount.astype(jnp.uint32)
 
 
@@ -25,12 +26,11 @@ def _shr(value, amount):
 
 def sprite_rows(sprite: jax.Array, x: jax.Array, clipping: bool) -> jax.Array:
     """(rows,) sprite bytes at column x (0..63) -> (rows, 2) uint32 row words."""
-    byte = sprite.astype(jnp.uint32)
-    shift = 56 - x  # left shift of the byte within the 64-bit row; -7..56
-    low_word = _shl(byte, shift) | _shr(byte, -shift)
-    high_word = _shl(byte, shift - 32) | _shr(byte, 32 - shift)
+    top = sprite.astype(jnp.uint32) << 24  # the byte in the top bits of a word: x = 0..7
+    high_word = _shr(top, x)
+    low_word = _shl(top, 32 - x) | _shr(top, x - 32)
     if not clipping:  # pixels past x = 63 come back at x = 0
-        high_word = high_word | _shl(byte, 32 + shift)
+        high_word = high_word | _shl(top, 64 - x)
     return jnp.stack([high_word, low_word], axis=-1)
 
 
@@ -50,7 +50,13 @@ def sprite_mask(aligned, x, y, height, clipping: bool) -> jax.Array:
     else:  # rows above y show the sprite rows that wrapped past the bottom
         covered = (offset & (SCREEN_HEIGHT - 1)) < height
         row_bytes = jnp.where(offset >= 0, aligned[:SCREEN_HEIGHT], aligned[SCREEN_HEIGHT:])
-    return jnp.where(covered[:, None], sprite_rows(row_bytes, x, clipping), jnp.uint32(0))
+    return sprite_rows(jnp.where(covered, row_bytes, 0), x, clipping)
+
+
+def collides(screen, mask) -> jax.Array:
+    """Whether XORing `mask` onto `screen` turns a lit pixel off."""
+    hits = jax.lax.reduce(screen & mask, jnp.uint32(0), jax.lax.bitwise_or, (0, 1))
+    return hits != 0
 
 
 def op_00e0(c: Context) -> dict:
