@@ -6,6 +6,7 @@ valid ones) and a non-positive `instructions_per_frame`.
 """
 
 import jax
+import numpy as np
 import pytest
 
 import octax_core
@@ -115,3 +116,48 @@ def test_instructions_per_frame_must_be_an_int(ipf):
 def test_quirks_need_all_six_fields():
     with pytest.raises(TypeError):
         octax_core.Quirks(vf_reset=True)
+
+
+# --- keys and frames given to run_frames ---------------------------------------------------------
+
+PROGRAM = bytes([0x12, 0x00])  # 1200: jump to self
+
+
+@pytest.fixture(scope="module")
+def booted():
+    machine = octax_core.Machine("chip8")
+    return machine, machine.boot(PROGRAM, jax.random.key(0))
+
+
+@pytest.mark.parametrize("mask", [-1, 0x10000, 1 << 20])
+def test_key_mask_out_of_range(booted, mask):
+    machine, state = booted
+    with pytest.raises(ValueError, match=r"key mask must be in 0\.\.0xFFFF"):
+        machine.run_frames(state, mask, 1)
+
+
+@pytest.mark.parametrize("shape", [(15,), (17,), (4, 4)])
+def test_key_array_of_the_wrong_length(booted, shape):
+    machine, state = booted
+    with pytest.raises(ValueError, match="16 entries"):
+        machine.run_frames(state, np.zeros(shape, bool), 1)
+
+
+def test_key_array_of_the_wrong_dtype(booted):
+    machine, state = booted
+    with pytest.raises(TypeError, match="bool\\[16\\] array or an integer bit mask"):
+        machine.run_frames(state, np.zeros(16, np.float32), 1)
+
+
+@pytest.mark.parametrize("frames, error, message", [(-1, ValueError, ">= 0"), (1.5, TypeError, "Python int")])
+def test_bad_frame_counts(booted, frames, error, message):
+    machine, state = booted
+    with pytest.raises(error, match=message):
+        machine.run_frames(state, 0, frames)
+
+
+def test_render_text_refuses_a_batch():
+    machine = octax_core.Machine("chip8")
+    batch = jax.vmap(lambda k: machine.boot(PROGRAM, k))(jax.random.split(jax.random.key(0), 2))
+    with pytest.raises(ValueError, match="one machine"):
+        octax_core.render_text(batch)
