@@ -1,0 +1,52 @@
+# make demo   boot a test ROM and print its screen as text
+# make test   run the test suite
+# make bench  throughput of the core on Pong, against the octax package (benchmarks/README.md)
+#
+# Each target creates .venv when it is missing and installs what it needs into it once: a stamp
+# file per extra (.venv/.installed-<extra>) is redone only when pyproject.toml changes.
+
+PYTHON ?= python3
+VENV   := .venv
+PY     := $(VENV)/bin/python
+PIP    := $(PY) -m pip
+
+# Only this torch is a local CPU wheel here; an unpinned torch pulls gigabytes of CUDA packages,
+# so it goes in first, before any extra that depends on torch gets to pick one.
+TORCH        := torch==2.13.0
+TORCH_EXTRAS := torch sb3 torchrl all
+
+# Third-party ROMs are never committed: tests and benchmarks read them from ../shared.
+export OCTAX_ROM_DIR ?= ../shared/roms/octax
+
+# Two pytest workers: JAX compiles are CPU-bound and mostly single-threaded, and on 2 cores this cut
+# the suite from ~50 s to ~35 s. loadfile keeps a file's tests, which share compiled functions, in
+# one worker. `make test PYTEST_ARGS=` runs serially; `make bench BENCH_ARGS=--quick` is a smoke test.
+PYTEST_ARGS ?= -n 2 --dist loadfile
+BENCH_ARGS  ?=
+
+.PHONY: help demo test bench clean
+
+help:
+	@sed -n 's/^# \(make .*\)/\1/p' Makefile
+
+demo: $(VENV)/.installed-core
+	$(PY) -m octax_core.demo
+
+test: $(VENV)/.installed-dev
+	$(PY) -m pytest $(PYTEST_ARGS)
+
+bench: $(VENV)/.installed-dev
+	$(PY) benchmarks/throughput.py $(BENCH_ARGS)
+
+$(PY):
+	$(PYTHON) -m venv $(VENV)
+
+# .installed-core installs the package alone; .installed-<extra> installs it with that extra.
+$(VENV)/.installed-%: pyproject.toml | $(PY)
+	$(if $(filter $*,$(TORCH_EXTRAS)),$(PY) -c "import torch" 2>/dev/null || $(PIP) install "$(TORCH)")
+	$(PIP) install -e "$(if $(filter core,$*),.,.[$*])"
+	touch $@
+
+clean:
+	rm -rf build dist *.egg-info .pytest_cache .hypothesis
+	find . -path ./$(VENV) -prune -o -name __pycache__ -type d -exec rm -rf {} +
