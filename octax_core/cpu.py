@@ -2,8 +2,9 @@
 
 Every handler runs on every instruction (under `vmap` there is no real branching), so handlers
 return small effects and `execute` merges them field by field with scalar selects on the decoded
-kind, then applies the merged effect once: one memory gather, one 16-byte memory write, one
-sprite XOR and a few register selects per instruction, whatever the opcode.
+kind, then applies the merged effect once. Whatever the opcode, an instruction costs two
+contiguous memory reads (opcode, 16 bytes at I), one 16-byte window write (two, to keep the
+mirror), one sprite read and XOR, and a few lane selects on the registers and the stack.
 """
 
 from __future__ import annotations
@@ -55,10 +56,22 @@ HANDLERS = {
     Kind.LOAD: memory.op_fx65,
 }  # Kind.NOP has no handler: every field keeps its default
 
-EFFECT_FIELDS = (
-    "pc", "vx", "vf", "i", "sp", "push", "mem_data", "mem_count", "load_count",
-    "delay_timer", "sound_timer", "rng", "key_wait", "clear",
-)
+EFFECT_FIELDS = {
+    "pc": "next pc (default pc + 2)",
+    "vx": "new value of Vx (default unchanged)",
+    "vf": "flag written to VF after vx (default none)",
+    "i": "new I (default unchanged)",
+    "sp": "new stack pointer (default unchanged)",
+    "push": "return address written to stack[sp] (default none)",
+    "mem_data": "(16,) bytes to write at I (default: the bytes already there)",
+    "mem_count": "how many of mem_data to write (default 0)",
+    "load_count": "load V0..V(count-1) from memory at I (default 0)",
+    "delay_timer": "new delay timer (default unchanged)",
+    "sound_timer": "new sound timer (default unchanged)",
+    "rng": "new xorshift32 state (default unchanged)",
+    "key_wait": "new FX0A progress (default unchanged)",
+    "clear": "clear the screen first (default False)",
+}
 
 
 def _lanes():
@@ -119,6 +132,9 @@ def execute(quirks: Quirks, state: MachineState, keys: jax.Array, stalled=None):
     # bytes, and XLA never has to copy the memory buffer to keep the old version alive.
     c = _context(quirks, state, keys, fields, window, collision=jnp.bool_(False))
     effects = {k: handler(c) for k, handler in HANDLERS.items() if k != Kind.DRW}
+    unknown = {field for effect in effects.values() for field in effect} - EFFECT_FIELDS.keys()
+    if unknown:  # checked while tracing, so it costs nothing per instruction
+        raise RuntimeError(f"handlers returned unknown effect fields {sorted(unknown)}")
 
     def merged(field, default):
         return _merge(kind, effects, field, default)
@@ -141,14 +157,14 @@ def execute(quirks: Quirks, state: MachineState, keys: jax.Array, stalled=None):
     V = jnp.where((lanes == 15) & _writes(kind, effects, "vf"), merged("vf", jnp.int32(0)), V)
 
     keep = jnp.where(merged("clear", jnp.bool_(False)), jnp.uint32(0), jnp.uint32(0xFFFFFFFF))
-    pushing = (lanes == c.sp) & (kind == Kind.CALL)
+    pushing = (lanes == c.sp) & _writes(kind, effects, "push")
     new_state = MachineState(
         memory=new_memory,
         V=V.astype(jnp.uint8),
         I=(merged("i", c.I) & 0xFFF).astype(jnp.uint16),
         pc=(merged("pc", c.pc + 2) & 0xFFF).astype(jnp.uint16),
         sp=merged("sp", c.sp).astype(jnp.uint8),
-        stack=jnp.where(pushing, (c.pc + 2) & 0xFFF, state.stack).astype(jnp.uint16),
+        stack=jnp.where(pushing, merged("push", c.pc) & 0xFFF, state.stack).astype(jnp.uint16),
         delay_timer=merged("delay_timer", c.delay_timer).astype(jnp.uint8),
         sound_timer=merged("sound_timer", state.sound_timer.astype(jnp.int32)).astype(jnp.uint8),
         screen=(state.screen & keep) ^ mask,

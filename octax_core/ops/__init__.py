@@ -1,9 +1,10 @@
 """Instruction handlers, one tiny function per opcode, grouped by family.
 
 A handler takes the `Context` of the instruction being executed and returns an effect: a dict
-holding only the fields it changes (see `octax_core.cpu.EFFECT_FIELDS`). Handlers never build a
-state; `octax_core.cpu` merges the effects field by field and applies the result once, so under
-`vmap` each field pays for a few scalar selects instead of every handler copying 4 KB of memory.
+holding only the fields it changes (`octax_core.cpu.EFFECT_FIELDS` lists them). Handlers never
+build a state; `octax_core.cpu` merges the effects field by field and applies the result once,
+so under `vmap` each field pays for a few scalar selects instead of every handler copying 4 KB
+of memory.
 """
 
 from __future__ import annotations
