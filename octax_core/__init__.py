@@ -1,15 +1,19 @@
-"""octax_core: a jitted, batched CHIP-8 machine in JAX (pure JAX + numpy).
+"""octax_core: a jitted, batched CHIP-8 machine in JAX (pure JAX + numpy), the game registry and
+a functional, Gymnax-style env API over it.
 
-See docs/machine.md for the exact machine contract.
+See docs/machine.md for the machine contract and docs/env.md for the env API.
 """
 
 from octax_core.decode import Kind
+from octax_core.env import Env, EnvConfig, EnvParams, EnvState, make, make_params
+from octax_core.games import GameSpec, get_spec, list_games
 from octax_core.machine import Machine
 from octax_core.quirks import QUIRK_PROFILES, Quirks
 from octax_core.rom import MAX_ROM_SIZE, PROGRAM_ADDRESS, Rom
 from octax_core.state import FONT, FONT_ADDRESS, MachineState, poke, render_text, snapshot
 
 __all__ = [
-    "FONT", "FONT_ADDRESS", "Kind", "MAX_ROM_SIZE", "Machine", "MachineState", "PROGRAM_ADDRESS",
-    "QUIRK_PROFILES", "Quirks", "Rom", "poke", "render_text", "snapshot",
+    "FONT", "FONT_ADDRESS", "Env", "EnvConfig", "EnvParams", "EnvState", "GameSpec", "Kind",
+    "MAX_ROM_SIZE", "Machine", "MachineState", "PROGRAM_ADDRESS", "QUIRK_PROFILES", "Quirks", "Rom",
+    "get_spec", "list_games", "make", "make_params", "poke", "render_text", "snapshot",
 ]
