@@ -7,6 +7,7 @@ free-form lines, then exactly one summary line starting with ``BENCH throughput`
     python benchmarks/throughput.py                    # N = 1, 64, 512, 2048, 8192, with octax
     python benchmarks/throughput.py --quick            # N = 64, 512, 2 repeats (smoke test)
     python benchmarks/throughput.py --envs 512 --devices 2 --no-octax
+    python benchmarks/throughput.py --mode env         # the functional env API: obs and reward too
 
 See benchmarks/README.md for what each field means.
 """
@@ -34,6 +35,9 @@ QUIRKS = "chip8"
 def _parse_args(argv: list[str] | None = None) -> argparse.Namespace:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--envs", default="1,64,512,2048,8192", help="comma-separated batch sizes N")
+    p.add_argument("--mode", choices=("machine", "env"), default="machine",
+                   help="machine: Machine.run_frames alone; env: octax_core.make('Pong') reset + step, "
+                        "observation (4 frames, uint8) and reward included (default machine)")
     p.add_argument("--steps", type=int, default=100, help="env steps per timed run (default 100)")
     p.add_argument("--repeats", type=int, default=5, help="timed runs per N; the best is kept (default 5)")
     p.add_argument("--key", type=int, default=1,
@@ -182,6 +186,38 @@ def prepare_machine(rom: Path, n: int, args: argparse.Namespace) -> Prepared:
     return Prepared(run, compile_s, _state_bytes(states), FRAMES_PER_STEP * INSTRUCTIONS_PER_FRAME, devices)
 
 
+def prepare_env(rom: Path, n: int, args: argparse.Namespace) -> Prepared:
+    """Our functional env: vmapped `env.step(key, state, action, params)`, scanned `steps` times.
+
+    Each step produces the (4, 32, 64) uint8 observation, the reward and the flags, and splits
+    its key, as an RL loop does; the observation rides in the carry so none of it is dropped.
+    """
+    import jax
+    import jax.numpy as jnp
+    import octax_core
+
+    env, params = octax_core.make("Pong", rom=rom, frames_per_step=FRAMES_PER_STEP,
+                                  instructions_per_frame=INSTRUCTIONS_PER_FRAME)
+    action = 0 if args.key < 0 else list(env.spec.action_keys).index(args.key) + 1
+    keys = jax.random.split(jax.random.key(0), n)
+    obs, states = jax.vmap(env.reset, in_axes=(0, None))(keys, params)
+    actions = jnp.full((n,), action, dtype=jnp.int32)
+    step = jax.vmap(env.step, in_axes=(0, 0, 0, None))
+
+    def rollout(carry, actions):
+        def body(carry, _):
+            keys, states, _ = carry
+            keys, step_keys = jnp.split(jax.vmap(jax.random.split)(keys), 2, axis=1)
+            obs, states, reward, terminated, truncated, _ = step(step_keys[:, 0], states, actions, params)
+            return (keys[:, 0], states, obs), None
+        carry, _ = jax.lax.scan(body, carry, length=args.steps)
+        return carry
+
+    run, compile_s, devices = _compile_rollout(rollout, (keys, states, obs), actions, args.devices)
+    state_bytes = _state_bytes(states)
+    return Prepared(run, compile_s, state_bytes, FRAMES_PER_STEP * INSTRUCTIONS_PER_FRAME, devices)
+
+
 def _octax_pong(rom: Path):
     """The octax Pong env, built as `octax.environments.create_environment("pong")` builds it.
 
@@ -249,7 +285,7 @@ def main(argv: list[str] | None = None) -> int:
         raise SystemExit(f"--devices {args.devices} but jax sees {jax.device_count()} devices")
 
     for n in args.envs:
-        ours = prepare_machine(rom, n, args)
+        ours = (prepare_env if args.mode == "env" else prepare_machine)(rom, n, args)
         theirs = None
         if not args.no_octax and (args.octax_max_envs == 0 or n <= args.octax_max_envs):
             theirs = prepare_octax(rom, n, args)
@@ -258,7 +294,7 @@ def main(argv: list[str] | None = None) -> int:
                       f"we run {ours.instructions_per_step}: the ratio compares unequal work", flush=True)
         _time_interleaved([ours] + ([theirs] if theirs else []), args.repeats)
         load = os.getloadavg()[0] if hasattr(os, "getloadavg") else float("nan")
-        for name, side in [("machine", ours), ("octax", theirs)]:
+        for name, side in [(args.mode, ours), ("octax", theirs)]:
             if side:
                 print(f"{name:7s} n={n}: {n * args.steps / side.best_s:,.0f} env steps/s "
                       f"({side.best_s * 1e3:.1f} ms for {args.steps} steps), compile {side.compile_s:.2f} s, "
@@ -267,7 +303,7 @@ def main(argv: list[str] | None = None) -> int:
         sps = n * args.steps / ours.best_s
         octax_sps = n * args.steps / theirs.best_s if theirs else None
         summary = {
-            "mode": "machine", "n": n, "devices": ours.devices, "steps": args.steps,
+            "mode": args.mode, "n": n, "devices": ours.devices, "steps": args.steps,
             "sps": round(sps), "ips": round(sps * ours.instructions_per_step),
             "state_bytes": ours.state_bytes, "compile_s": round(ours.compile_s, 2),
             "octax_sps": round(octax_sps) if theirs else None,
