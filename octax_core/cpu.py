@@ -194,17 +194,30 @@ def tick_timers(state: MachineState) -> MachineState:
     return state.replace(delay_timer=tick(state.delay_timer), sound_timer=tick(state.sound_timer))
 
 
-def run_frame(quirks: Quirks, instructions_per_frame: int, state: MachineState, keys) -> MachineState:
-    """One 60 Hz frame: up to `instructions_per_frame` instructions, then the timer tick."""
+def run_frame(quirks: Quirks, instructions_per_frame: int, state: MachineState, keys,
+              halted=None) -> MachineState:
+    """One 60 Hz frame: up to `instructions_per_frame` instructions, then the timer tick.
+
+    `halted` (bool, optional) freezes the machine for the frame: no instruction runs and the
+    timers do not tick, so the state comes back unchanged (the env uses it for ended episodes).
+    """
+    gated = quirks.display_wait or halted is not None
+
     def instruction(carry, _):
         state, frame_over = carry
-        state, drew = execute(quirks, state, keys, frame_over if quirks.display_wait else None)
+        state, drew = execute(quirks, state, keys, frame_over if gated else None)
         if quirks.display_wait:  # the VIP's DXYN waits for the next vertical blank
             frame_over = frame_over | drew
         return (state, frame_over), None
 
     # Built from the state so that it is batched / sharded like the state (shard_map, vmap).
     frame_over = jnp.zeros_like(state.key_wait, dtype=jnp.bool_)
+    if halted is not None:
+        frame_over = frame_over | halted
     (state, _), _ = jax.lax.scan(instruction, (state, frame_over), None,
                                  length=instructions_per_frame)
-    return tick_timers(state)
+    ticked = tick_timers(state)
+    if halted is None:
+        return ticked
+    return state.replace(delay_timer=jnp.where(halted, state.delay_timer, ticked.delay_timer),
+                         sound_timer=jnp.where(halted, state.sound_timer, ticked.sound_timer))

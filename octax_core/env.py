@@ -133,22 +133,24 @@ class Env:
         action = self._check_action(action)
         repeat = jax.random.uniform(sticky_key) < params.repeat_action_probability
         action = jnp.where(repeat, state.last_action, action)
-        machine, screens = self._run_step(state.machine, jnp.asarray(self._action_masks)[action])
-
+        # pgx's rule: an ended episode stands still until it is reset. The machine is halted
+        # rather than stepped and then discarded, so its 4 KB of memory is never selected over,
+        # and the frames it returns are its last screen.
+        machine, screens = self._run_step(state.machine, jnp.asarray(self._action_masks)[action],
+                                          halted=state.done)
         score = self._score(machine)
         terminated = jnp.asarray(self.spec.terminated_fn(machine), jnp.bool_)
-        episode_step = state.episode_step + 1
-        truncated = (episode_step >= params.max_episode_steps) & ~terminated
-        stepped = EnvState(machine, score, episode_step, action, terminated | truncated)
-        reward = score - state.score
-
-        # pgx's rule: an ended episode stands still until it is reset.
-        new_state = jax.tree.map(lambda old, new: jnp.where(state.done, old, new), state, stepped)
-        reward = jnp.where(state.done, 0.0, reward).astype(jnp.float32)
-        terminated = jnp.where(state.done, _ended_by_termination(state, self.spec), terminated)
-        truncated = jnp.where(state.done, ~terminated, truncated)
-        still = jnp.broadcast_to(self._pixels(state.machine.screen[None]), self.observation_shape)
-        obs = jnp.where(state.done, still, self._pixels(screens))
+        episode_step = jnp.where(state.done, state.episode_step, state.episode_step + 1)
+        truncated = ~terminated & (episode_step >= params.max_episode_steps)
+        reward = jnp.where(state.done, 0.0, score - state.score).astype(jnp.float32)
+        new_state = EnvState(
+            machine=machine,
+            score=score,
+            episode_step=episode_step,
+            last_action=jnp.where(state.done, state.last_action, action),
+            done=terminated | truncated,
+        )
+        obs = self._pixels(screens)
         info = {"score": new_state.score, "lives": self._lives(new_state.machine),
                 "episode_step": new_state.episode_step}
         if self.config.autoreset:
@@ -157,10 +159,11 @@ class Env:
 
     # --- pieces -------------------------------------------------------------------------------
 
-    def _run_step(self, machine: MachineState, keys) -> tuple[MachineState, jax.Array]:
+    def _run_step(self, machine: MachineState, keys, halted=None) -> tuple[MachineState, jax.Array]:
         """frames_per_step frames with `keys` held; returns the packed screen after each."""
         def frame(machine, _):
-            machine = cpu.run_frame(self.machine.quirks, self.config.instructions_per_frame, machine, keys)
+            machine = cpu.run_frame(self.machine.quirks, self.config.instructions_per_frame, machine,
+                                    keys, halted)
             return machine, machine.screen
 
         machine, screens = jax.lax.scan(frame, machine, None, length=self.config.frames_per_step)
@@ -200,9 +203,6 @@ class Env:
         action = jnp.asarray(action, jnp.int32)
         return jnp.where((action >= 0) & (action < self.num_actions), action, 0)
 
-
-def _ended_by_termination(state: EnvState, spec: GameSpec) -> jax.Array:
-    return jnp.asarray(spec.terminated_fn(state.machine), jnp.bool_)
 
 
 @functools.lru_cache(maxsize=None)

@@ -1,0 +1,52 @@
+"""Brix (Andreas Gustafsson, 1990): Breakout; bounce the ball off a paddle into 96 bricks.
+
+### Observation
+The screen, uint8 (frames_per_step, 32, 64): 6 rows of 16 bricks, the paddle at the bottom,
+the lives left and the score on top.
+
+### Actions
+0: no-op, 1: key 4 (paddle left), 2: key 6 (paddle right).
+
+### Reward
+Change of V5, the bricks destroyed: +1 per brick.
+
+### Termination
+V14 (lives, 5 at the start) reaches 0, or V5 reaches 96 (all bricks gone); in both cases the
+ROM halts in a jump-to-self (pc 0x2DE). The paper says "game over when V[14] equals 4 (no more
+lives)" and the octax package tests V14 == 4, which ends the episode at the first lost ball;
+we keep the stated meaning, no lives left, which is where the ROM itself stops.
+
+Quirks "chip8": an original CHIP-8 program (community database: originalChip8); the quirks
+that differ do not change its logic (no shift or BNNN; VF after 8XY2/8XY3 and I after FX65 are
+never read), so the profile only sets the VIP's display-wait pacing: one brick per frame while
+the wall is drawn, four frames per ball move. Timers: real 60 Hz; the game waits 64 frames (16
+steps) before each serve. Start-up: 160 frames (octax: 500 instructions = 46), the wall drawn
+and 5 frames before the first serve, whose column is drawn from the reset key. Episodes are cut
+at 4,500 steps (5 minutes).
+"""
+
+import jax.numpy as jnp
+
+from octax_core.games.spec import GameSpec
+
+
+def _v(state, i):
+    return state.V[i].astype(jnp.int32)
+
+
+SPECS = (GameSpec(
+    id="Brix",
+    title="Brix",
+    rom_file="Brix [Andreas Gustafsson, 1990].ch8",
+    rom_sha1="f13766c14aeb02ad8d4d103cb5eadd282d20cddc",
+    action_keys=(4, 6),
+    score_fn=lambda state: _v(state, 5),
+    terminated_fn=lambda state: (state.V[14] == 0) | (state.V[5] == 96),
+    lives_fn=lambda state: _v(state, 14),
+    startup=((0, 160),),
+    quirks="chip8",
+    max_episode_steps=4500,
+    category="timing",
+    description="Move the paddle (keys 4 left, 6 right) to bounce the ball into the bricks; reward "
+                "+1 per brick; the game ends when the 5 balls are lost or all 96 bricks are gone.",
+),)
