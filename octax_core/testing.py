@@ -33,8 +33,6 @@ def check_env(game: Union[str, GameSpec], *, num_envs: int = 3, steps: int = 12,
         AssertionError: a broken promise, named in the message.
     """
     env, params = make(game, rom=rom, **overrides)
-    _check_single(env, params)
-    _check_action_refused(env, params)
     keys = jax.random.split(jax.random.key(seed), num_envs)
     actions = jax.random.randint(jax.random.key(seed + 1), (steps, num_envs), 0, env.num_actions)
     traces = []
@@ -45,10 +43,12 @@ def check_env(game: Union[str, GameSpec], *, num_envs: int = 3, steps: int = 12,
 
     reset = jax.jit(jax.vmap(env.reset, in_axes=(0, None)))
     step = jax.jit(jax.vmap(counted_step, in_axes=(0, 0, 0, None)))
+    _check_outputs(env, params, reset, step, keys)
+    _check_action_refused(env, params, reset, keys)
     batched = _rollout(reset, step, params, keys, actions)
     again = _rollout(reset, step, params, keys, actions)
     _assert_trees_equal(batched, again, "the same keys and actions gave different trajectories")
-    assert len(traces) == 1, f"step was traced {len(traces)} times over {2 * steps} calls; expected once"
+    assert len(traces) == 1, f"step was traced {len(traces)} times over {2 * steps + 1} calls; expected once"
     alone = _rollout(reset, step, params, keys[:1], actions[:, :1])
     _assert_trees_equal(jax.tree.map(lambda x: x[:, :1], batched), alone,
                         "env 0 of a batch differs from the same env run alone: batch size leaks in")
@@ -56,24 +56,25 @@ def check_env(game: Union[str, GameSpec], *, num_envs: int = 3, steps: int = 12,
     assert np.all(np.isfinite(rewards)), f"{env.spec.id}: non-finite rewards {rewards[~np.isfinite(rewards)]}"
 
 
-def _check_single(env: Env, params: EnvParams) -> None:
-    name = env.spec.id
-    obs, state = jax.jit(env.reset)(jax.random.key(0), params)
-    assert obs.shape == env.observation_shape, f"{name}: reset obs shape {obs.shape} != {env.observation_shape}"
+def _check_outputs(env: Env, params: EnvParams, reset, step, keys) -> None:
+    """Shapes, dtypes, pixel values and info keys of one batched reset and step."""
+    name, n = env.spec.id, len(keys)
+    obs, state = reset(keys, params)
+    assert obs.shape == (n, *env.observation_shape), f"{name}: reset obs shape {obs.shape[1:]} != {env.observation_shape}"
     assert obs.dtype == jnp.uint8, f"{name}: obs dtype {obs.dtype} != uint8"
     assert set(np.unique(np.asarray(obs))) <= {0, env.config.obs_scale}, f"{name}: obs pixels not 0/{env.config.obs_scale}"
-    obs, state, reward, terminated, truncated, info = jax.jit(env.step)(jax.random.key(1), state, 0, params)
-    assert obs.shape == env.observation_shape and obs.dtype == jnp.uint8, f"{name}: step obs {obs.shape} {obs.dtype}"
-    assert reward.shape == () and reward.dtype == jnp.float32, f"{name}: reward {reward.shape} {reward.dtype}"
+    obs, state, reward, terminated, truncated, info = step(keys, state, jnp.zeros(n, jnp.int32), params)
+    assert obs.shape == (n, *env.observation_shape) and obs.dtype == jnp.uint8, f"{name}: step obs {obs.shape} {obs.dtype}"
+    assert reward.shape == (n,) and reward.dtype == jnp.float32, f"{name}: reward {reward.shape} {reward.dtype}"
     for flag_name, flag in (("terminated", terminated), ("truncated", truncated)):
-        assert flag.shape == () and flag.dtype == jnp.bool_, f"{name}: {flag_name} {flag.shape} {flag.dtype}"
+        assert flag.shape == (n,) and flag.dtype == jnp.bool_, f"{name}: {flag_name} {flag.shape} {flag.dtype}"
     missing = {"score", "lives", "episode_step"} - set(info)
     assert not missing, f"{name}: info lacks {sorted(missing)}"
-    assert int(info["episode_step"]) == 1, f"{name}: episode_step after one step is {int(info['episode_step'])}"
+    assert np.all(np.asarray(info["episode_step"]) == 1), f"{name}: episode_step after one step is not 1"
 
 
-def _check_action_refused(env: Env, params: EnvParams) -> None:
-    state = jax.jit(env.reset)(jax.random.key(0), params)[1]
+def _check_action_refused(env: Env, params: EnvParams, reset, keys) -> None:
+    state = jax.tree.map(lambda x: x[0], reset(keys, params)[1])
     for bad in (-1, env.num_actions):
         try:
             env.step(jax.random.key(0), state, bad, params)

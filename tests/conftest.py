@@ -18,7 +18,9 @@ import octax_core
 REPO = Path(__file__).resolve().parents[1]
 SHARED = REPO.parent / "shared"
 TEST_SUITE_DIR = SHARED / "roms" / "test-suite"
-OCTAX_ROM_DIR = Path(os.environ.get("OCTAX_ROM_DIR", SHARED / "roms" / "octax")).resolve()
+# Tests read the third-party ROMs from ../shared (never from git); `make test` sets this too.
+os.environ.setdefault("OCTAX_ROM_DIR", str(SHARED / "roms" / "octax"))
+OCTAX_ROM_DIR = Path(os.environ["OCTAX_ROM_DIR"]).resolve()
 
 
 @functools.lru_cache(maxsize=None)
