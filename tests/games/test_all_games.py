@@ -52,3 +52,12 @@ def test_random_policy_gives_finite_rewards(game_id, octax_rom_dir):
         _, state, reward, _, _, _ = step(keys[t], state, actions[t], params)
         total += np.asarray(reward)
     assert np.all(np.isfinite(total)), f"{game_id}: returns {total}"
+
+
+def test_docs_games_table_is_current():
+    import runpy
+    from pathlib import Path
+
+    docs = Path(__file__).resolve().parents[2] / "docs"
+    table = runpy.run_path(str(docs / "games_table.py"))["games_table"]()
+    assert table in (docs / "games.md").read_text(), "docs/games.md is stale: run python docs/games_table.py"
