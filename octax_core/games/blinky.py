@@ -8,13 +8,17 @@ Blinky and the two ghosts (Packlett and Heward).
 0: no-op, 1: key 3 (down), 2: key 6 (up), 3: key 7 (left), 4: key 8 (right).
 
 ### Reward
-Change of the game's score: 1 per pill, 4 per energy pill, 50 for Packlett and 25 for Heward
-caught while energized, and 100 for a cleared maze. The ROM counts the current maze's pills in
-V6, adds V6 to a 16-bit total at RAM 0x8C8 (high byte first) when the maze is cleared or the
-game ends, and then zeroes V6; the ghost bonuses go straight to the total. The score is total +
-V6 (across the step that clears a maze it may count V6 twice for a moment: the rewards around
-it still add up to the pill and the bonus). The paper rewards V6 alone, which misses the ghosts
-and drops by 247 at every cleared maze.
+Change of V6, the paper's score register: 1 per pill and 4 per energy pill of the current maze.
+
+Where the ROM and the paper disagree: V6 is not the game's score. The ROM counts the current
+maze's pills in V6, adds V6 to a 16-bit total at RAM 0x8C8 (high byte first) when the maze is
+cleared or the game ends, and then zeroes V6; the ghost bonuses (50 for Packlett and 25 for
+Heward caught while energized) and the 100 for a cleared maze go straight to the total. So
+under the paper's rule catching a ghost earns nothing, and clearing a maze (247 in pills) is
+one large negative reward: +1 for the last pill, then -247 four steps later as V6 drops back to
+0 (measured). For the game's own score (total + V6) use instead, in a `dataclasses.replace` of
+this spec, `score_fn=lambda s: s.memory[MEMORY_OFFSET + 0x8C8].astype(jnp.int32) * 256 +
+s.memory[MEMORY_OFFSET + 0x8C9] + s.V[6].astype(jnp.int32)` (`octax_core.state.MEMORY_OFFSET`).
 
 ### Termination
 V3 equals 255: the first time a ghost catches Blinky (the ROM's death pause at 0x8A8 counts
@@ -31,14 +35,6 @@ while the ROM copies and draws the maze, up to its main loop. Episodes are cut a
 import jax.numpy as jnp
 
 from octax_core.games.spec import GameSpec
-from octax_core.state import MEMORY_OFFSET
-
-_TOTAL = MEMORY_OFFSET + 0x8C8  # the banked score, high byte first
-
-
-def _score(state):
-    total = state.memory[_TOTAL].astype(jnp.int32) * 256 + state.memory[_TOTAL + 1].astype(jnp.int32)
-    return total + state.V[6].astype(jnp.int32)
 
 
 SPECS = (GameSpec(
@@ -47,7 +43,7 @@ SPECS = (GameSpec(
     rom_file="Blinky [Hans Christian Egeberg, 1991].ch8",
     rom_sha1="d40abc54374e4343639f993e897e00904ddf85d9",
     action_keys=(3, 6, 7, 8),
-    score_fn=_score,
+    score_fn=lambda state: state.V[6].astype(jnp.int32),  # the paper's rule
     terminated_fn=lambda state: state.V[3] == 255,
     startup=((0, 1251),),
     quirks="schip",

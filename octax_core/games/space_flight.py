@@ -12,12 +12,21 @@ move per 6-7 frames, 53 steps for a crossing); the key held moves it one row.
 Change of V0, +1 per move survived: 30 for a full crossing.
 
 ### Termination
-V9 (lives, 1) reaches 0 on a collision, or the ship crosses the field. The paper tests the
-crossing as VC (ship x) >= 0x3E, but VC holds 0x3E for only 2 frames before the ROM restarts
-the ship on the left of a new field, so a step of 5 or more frames can miss it and the episode
-runs on into further fields (V0 wraps past 255). We also end on VA != 4: VA counts the
-crossings down from 4 and only changes on one. With the default 4 frames per step both tests
-fire on the same step (53); otherwise ours fires at most one step later.
+V9 (lives, 1) equals 0, a collision, or VC (ship x) >= 0x3E, the ship at the right edge: the
+paper's rule, `(V[9] == 0) | (V[12] >= 0x3E)`. With the default 4 frames per step a crossing
+ends on step 53.
+
+Where the ROM and the paper disagree: the ROM holds VC at 0x3E for only 2 frames, then starts
+the ship on the left of a new field (VA, 4 at the start, counts the crossings down), and the
+paper's rule is read once per step, after its last frame. The 2 frames are frames 212-213 after
+start-up at every level, whatever the keys (measured), so steps of 1 to 4 frames see them (212
+= 4 x 53) but other `frames_per_step` values can miss them (5 to 52 do): the crossing then
+does not end the episode, which runs on into further fields until a collision or the step cut
+(V0 wraps past 255). With 5 frames per step, SpaceFlight1's crossing passes unseen in step 43
+and no-ops then crash at the next field's first move, step 56. To end on every crossing
+whatever the step length, use instead
+`terminated_fn=lambda s: (s.V[9] == 0) | (s.V[12] >= 0x3E) | (s.V[10] != 4)` in a
+`dataclasses.replace` of this spec.
 
 ### Levels
 The ten ROMs differ in one byte, the level (VB = 1..10), which sets the number of asteroids:
@@ -29,7 +38,8 @@ and the game also plays under "schip". Timers: real 60 Hz; the game waits 5 fram
 Start-up: 34 + (asteroids) frames, the field drawn and the ship about to make its first move;
 octax's 300 instructions (28 frames) stop mid-field. The field is drawn at start-up, from a
 fixed seed, so every episode of a level is the same field (as in octax). Episodes are cut at
-500 steps; one always ends within about 55.
+500 steps; with 4 frames per step one always ends within 53 (not so with other step lengths,
+see above).
 """
 
 import jax.numpy as jnp
@@ -51,8 +61,7 @@ _LEVELS = (  # ROM file, SHA-1, asteroids
 
 
 def _terminated(state):
-    crashed = state.V[9] == 0
-    return crashed | (state.V[12] >= 0x3E) | (state.V[10] != 4)
+    return (state.V[9] == 0) | (state.V[12] >= 0x3E)  # the paper's rule, exactly
 
 
 def _spec(level: int, rom_file: str, sha1: str, asteroids: int) -> GameSpec:

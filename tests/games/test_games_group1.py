@@ -301,10 +301,15 @@ def test_blinky_eats_pills(rom_dir):
     assert run.reward[:, 1].sum() >= 3  # measured: 5 pills, then a wall
 
 
-def test_blinky_a_cleared_maze_scores_its_bonus(rom_dir):
+def test_blinky_the_score_is_v6_and_a_cleared_maze_drops_it_to_0(rom_dir):
+    """The paper's score, V6, counts the current maze's pills; the ROM banks them (and the 100
+    bonus) in RAM and zeroes V6 when the maze is cleared: one large negative reward."""
     run = _run_with_register("Blinky", rom_dir, 6, 246, 4)  # one pill short of the maze's 247; key 8
-    assert run.reward[:, 0].sum() == 101  # the last pill and the 100 bonus; V6 restarts at 0
-    assert run.V[-1, 0, 6] < 10 and not run.terminated[:, 0].any()
+    last_pill, clear = run.first_reward(0), run.first_reward(0, -1)
+    assert run.reward[last_pill, 0] == 1 and run.V[last_pill, 0, 6] == 247
+    assert clear is not None and clear - last_pill < 10  # measured: 4 steps after the last pill
+    assert run.reward[clear, 0] == -247 and run.V[clear, 0, 6] == 0
+    assert (run.score[:, 0] == run.V[:, 0, 6]).all() and not run.terminated[:, 0].any()
 
 
 def test_worm_eats_food(rom_dir):
@@ -349,8 +354,8 @@ def test_filter_catches_drops(rom_dir):
 
 @pytest.mark.parametrize("game_id, env, bound, final_score, final_lives", [
     ("Pong", 1, 1000, (-9, -1), None),  # key 1 held; measured: 749, 0-9
-    ("Brix", 0, 600, (1, 95), 0),  # no-op; measured: 464, 34 bricks
-    ("Brix", 1, 600, (0, 95), 0),  # key 4 held; measured: 260
+    ("Brix", 0, 170, (1, 95), 4),  # no-op, ends at the first lost ball; measured: 128, 11 bricks
+    ("Brix", 1, 100, (0, 95), 4),  # key 4 held; measured: 64, 2 bricks
     ("Tetris", 1, 400, (0, 0), None),  # drop held; measured: 312
     ("Blinky", 0, 500, (0, 0), None),  # no-op; measured: 390
     ("Worm", 0, 60, (0, 1), None),  # no-op, into the right wall; measured: 42
@@ -383,11 +388,23 @@ def test_a_won_game_ends(rom_dir, game_id, register, value, action):
 
 
 def test_lives_count_down_one_at_a_time(rom_dir):
-    for game_id, env, start in (("Brix", 0, 5), ("VerticalBrix", 0, 3), ("Filter", 0, 7)):
+    # Brix ends on the paper's V14 == 4: at its first lost ball, with 4 of its 5 balls left
+    for game_id, env, start, last in (("Brix", 0, 5, 4), ("VerticalBrix", 0, 3, 0), ("Filter", 0, 7, 0)):
         run = _scripted(game_id, rom_dir)
         lives = run.lives[:run.first_end(env) + 1, env]
-        assert lives[0] == start and lives[-1] == 0
+        assert lives[0] == start and lives[-1] == last
         assert set(np.diff(lives)) <= {0, -1}
+
+
+def test_brix_every_episode_is_one_ball(rom_dir):
+    """Under the paper's V14 == 4, every episode ends as its first ball is lost (the ROM would
+    serve 4 more): random play ends each episode with 4 lives and at most a few hundred steps."""
+    run = _random("Brix", rom_dir)
+    assert (run.lives[run.terminated] == 4).all()
+    for i in range(N):
+        ends = np.flatnonzero(run.terminated[:, i])
+        assert len(ends) >= 10  # measured: 555 episodes over 16 envs, 30-39 per env
+        assert np.diff(np.concatenate([[-1], ends])).max() < 340  # measured: 33-303 steps
 
 
 # ---- (4) random play -------------------------------------------------------------------------
@@ -395,7 +412,7 @@ def test_lives_count_down_one_at_a_time(rom_dir):
 REWARD_VALUES = {
     "Pong": {-1, 0, 1}, "Brix": {0, 1}, "Tetris": {0, 1, 2, 3, 4}, "Worm": {0, 1}, "Squash": {-1, 0},
     "VerticalBrix": {0, 1}, "WipeOff": {0, 1}, "Filter": {0, 1},
-    "Blinky": {0, 1, 4, 25, 50},  # pill, energy pill, Heward, Packlett (a maze is out of reach)
+    "Blinky": {0, 1, 4},  # pill, energy pill; V6 never holds the ghost bonuses (a maze's -247: out of reach)
 }
 
 

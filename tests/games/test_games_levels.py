@@ -27,6 +27,9 @@ NUM_ENVS = 16
 # Found by a beam search over (no-op, up, down) on SpaceFlight1's field, which start-up draws
 # from the boot key 0: crosses without a collision in 53 steps.
 SPACE_FLIGHT1_CROSSING = "...^.^.^.^^.^.^.^^.^.^.^^.^.^.^^.^.^.^^.^.^.^^.^.^...."
+# The same crossing in 5-frame steps (each move's key moved to the step that holds it at the move).
+SPACE_FLIGHT1_CROSSING_5 = "...^^^.^^.^^^.^^.^^^.^^.^^^.^^.^^^.^^.^^....."
+SPACE_FLIGHT_EDGE = (212, 213)  # the frames after start-up at which VC == 0x3E, at every level
 
 
 @functools.cache
@@ -133,19 +136,37 @@ def test_target_shooter_timeouts_end_the_game(game_id, bound, octax_rom_dir):
     assert steps < spec.max_episode_steps
 
 
-def test_space_flight_crossing_ends_even_when_steps_straddle_it(octax_rom_dir):
-    """The paper's VC >= 0x3E holds for only 2 frames; the spec's VA test does not depend on it."""
+def test_space_flight_crossing_is_a_2_frame_window(octax_rom_dir):
+    """The paper's rule sees a crossing only while VC >= 0x3E, 2 frames, before the ROM starts
+    the ship on a new field: a 4-frame step ends in them, a 5-frame step straddles them."""
     spec, machine, state = _start("SpaceFlight1", octax_rom_dir)
     run, frames = _runner(machine), []
-    for action in SPACE_FLIGHT1_CROSSING:
+    for action in SPACE_FLIGHT1_CROSSING:  # 216 frames: the crossing and 3 frames of the next field
         for _ in range(FRAMES_PER_STEP):
             state = run(state, _mask(spec, ".^v".index(action)), 1)
-            frames.append((int(state.V[12]), bool(spec.terminated_fn(state)), int(state.V[9])))
-    edge = [i for i, (x, _, _) in enumerate(frames, 1) if x >= 0x3E]
-    assert len(edge) == 2 and frames[-1][2] == 1, f"expected a 2-frame crossing, got frames {edge}"
-    assert edge[0] % FRAMES_PER_STEP == 0, "with 4-frame steps the paper's test should see the edge"
-    assert not any(frame % 5 == 0 for frame in edge), "with 5-frame steps the paper's test misses it"
-    assert all(ended for _, ended, _ in frames[edge[0] - 1:]), "the spec must stay terminated"
+            frames.append((bool(spec.terminated_fn(state)), int(state.V[9]), int(state.V[10])))
+    ended = tuple(i for i, (done, _, _) in enumerate(frames, 1) if done)
+    assert ended == SPACE_FLIGHT_EDGE, f"the paper's rule held at frames {ended}"
+    assert frames[-1] == (False, 1, 3), "after the window: no collision, one crossing counted, not terminated"
+    assert SPACE_FLIGHT_EDGE[0] % FRAMES_PER_STEP == 0, "with 4-frame steps the paper's test sees the edge"
+    assert not any(frame % 5 == 0 for frame in ended), "with 5-frame steps the paper's test misses it"
+
+
+@pytest.mark.parametrize("game_id", SPACE_FLIGHT)
+def test_space_flight_every_level_crosses_at_the_same_frames(game_id, octax_rom_dir):
+    """With the asteroids wiped (only x < 8, the ship, kept) every level crosses at frames 212-213,
+    which 4-frame steps always see: the paper's rule ends a 4-frame crossing on step 53."""
+    spec, machine, state = _start(game_id, octax_rom_dir)
+    state = state.replace(screen=state.screen & np.array([0xFF000000, 0], np.uint32))
+    run = _runner(machine)
+    state = run(state, 0, SPACE_FLIGHT_EDGE[0] - 1)
+    flags = []
+    for _ in range(3):
+        flags.append(bool(spec.terminated_fn(state)))
+        state = run(state, 0, 1)
+    flags.append(bool(spec.terminated_fn(state)))
+    assert flags == [False, True, True, False], f"the paper's rule over frames 211-214: {flags}"
+    assert (int(state.V[9]), int(state.V[10]), int(state.V[12])) == (1, 3, 0), "not on a new field"
 
 
 # --- one level per family through the env API -----------------------------------------------
@@ -209,6 +230,26 @@ def test_env_space_flight1_crossing_and_crash(octax_rom_dir):
     assert (ended_at == 53).all() and (returns == 30).all(), (ended_at, returns)
     ended_at, returns, _ = _episode("SpaceFlight1", octax_rom_dir, lambda state: 0, 60)
     assert (ended_at == 10).all() and (returns == 5).all(), (ended_at, returns)
+
+
+def test_env_space_flight1_at_5_frames_per_step_flies_past_the_crossing(octax_rom_dir):
+    """With 5-frame steps the paper's rule misses the crossing (frames 212-213 fall in step 43):
+    the episode runs on into a new field, where no-ops crash at its first move (step 56)."""
+    env, params = octax_core.make("SpaceFlight1", rom=octax_rom_dir / "space_flight1.ch8", frames_per_step=5)
+    actions = [".^v".index(a) for a in SPACE_FLIGHT1_CROSSING_5] + [0] * 15
+    step = jax.jit(env.step)
+    _, state = env.reset(jax.random.key(0), params)
+    ended_at, rewards, crossings = None, [], []
+    for t, action in enumerate(actions, 1):
+        _, state, reward, terminated, truncated, _ = step(jax.random.key(t), state, action, params)
+        rewards.append(float(reward))
+        crossings.append(4 - int(state.machine.V[10]))  # VA counts the crossings down from 4
+        if bool(terminated | truncated):
+            ended_at = t
+            break
+    assert crossings[42] == 1 and crossings[41] == 0, "the ship did not cross in step 43"
+    assert ended_at == 56 and int(state.machine.V[9]) == 0, (ended_at, int(state.machine.V[9]))
+    assert sum(rewards) == 30 and not bool(truncated)
 
 
 def test_env_target_shooter1_aiming_hits_ten(octax_rom_dir):
