@@ -15,20 +15,20 @@ below are measured values (noted beside each) plus a margin.
 
 from __future__ import annotations
 
-import dataclasses
-import functools
-from typing import Callable, Optional
-
 import jax
 import jax.numpy as jnp
 import numpy as np
 import pytest
+from game_harness import (
+    CHUNK,
+    Harness,
+    N,
+    Plan,
+    Rollout,
+    assert_episode_adds_up,
+    reset_keys,
+)
 
-import octax_core
-
-N = 16  # envs per rollout
-CHUNK = 100  # steps per compiled scan
-RANDOM_STEPS = 1500
 GAMES = ("Pong", "Brix", "Tetris", "Blinky", "Worm", "Squash", "VerticalBrix", "WipeOff", "Filter")
 
 # Tetris: env 0 (reset key fold_in(key(0), 0)) clears its first line at the last step of this string.
@@ -63,20 +63,10 @@ def _filter_greedy(machine):
     return jnp.where(drop < paddle + 1, 1, jnp.where(drop > paddle + 4, 2, 0))
 
 
-@dataclasses.dataclass(frozen=True)
-class Plan:
-    """The scripted rollout: `envs[i]` drives env i (an int: that action held; a tuple: cycled;
-    a str: replayed digit by digit, then drops; "policy": the closed-loop `policy`)."""
-
-    steps: int
-    envs: tuple
-    policy: Optional[Callable] = None
-
-
 PLANS = {
     "Pong": Plan(1000, (0, 1, 2)),
     "Brix": Plan(600, (0, 1, 2)),
-    "Tetris": Plan(800, (TETRIS_LINE, 4, 2, 3)),
+    "Tetris": Plan(800, (TETRIS_LINE, 4, 2, 3), replay_then=4),  # after the line: drops
     "Blinky": Plan(600, (0, 4, 3, 1)),
     "Worm": Plan(400, (0, "policy", "policy", "policy", "policy", "policy", "policy", 1, 2), _worm_greedy),
     "Squash": Plan(400, (0, (1, 0), (2, 0))),
@@ -86,95 +76,14 @@ PLANS = {
 }
 
 
-@dataclasses.dataclass(frozen=True)
-class Rollout:
-    """Per step t and env i: reward, terminated, truncated, the score and lives of the episode
-    the step belonged to (final values when it ended there), and the registers after the step."""
-
-    reward: np.ndarray  # (T, N) float32
-    terminated: np.ndarray  # (T, N) bool
-    truncated: np.ndarray  # (T, N) bool
-    score: np.ndarray  # (T, N) float32
-    lives: np.ndarray  # (T, N) int32
-    V: np.ndarray  # (T, N, 16) uint8
-
-    def first_end(self, i: int) -> Optional[int]:
-        ends = np.flatnonzero(self.terminated[:, i])
-        return int(ends[0]) if len(ends) else None
-
-    def first_reward(self, i: int, sign: int = 1) -> Optional[int]:
-        hits = np.flatnonzero(np.sign(self.reward[:, i]) == sign)
-        return int(hits[0]) if len(hits) else None
-
-
-@functools.lru_cache(maxsize=None)
-def _compiled(game_id: str, rom_dir: str):
-    """make() plus the jitted batched reset and chunk runner; one compile each per game."""
-    env, params = octax_core.make(game_id, rom=rom_dir, autoreset=True)
-    policy = PLANS[game_id].policy
-    step = jax.vmap(env.step, in_axes=(0, 0, 0, None))
-
-    def run(state, actions, use_policy, key):
-        def body(state, xs):
-            actions, step_key = xs
-            if policy is not None:
-                actions = jnp.where(use_policy, jax.vmap(policy)(state.machine), actions)
-            _, state, reward, terminated, truncated, info = step(jax.random.split(step_key, N), state, actions, params)
-            final = info["final_info"]
-            return state, (reward, terminated, truncated, final["score"], final["lives"], state.machine.V)
-        return jax.lax.scan(body, state, (actions, jax.random.split(key, CHUNK)))
-
-    return env, params, jax.jit(jax.vmap(env.reset, in_axes=(0, None))), jax.jit(run)
-
-
-def _reset_keys():
-    return jax.vmap(lambda i: jax.random.fold_in(jax.random.key(0), i))(jnp.arange(N))
-
-
-def _rollout(game_id: str, rom_dir: str, actions: np.ndarray, use_policy: np.ndarray, seed: int) -> Rollout:
-    env, params, reset, run = _compiled(game_id, rom_dir)
-    _, state = reset(_reset_keys(), params)
-    outs = []
-    for c in range(len(actions) // CHUNK):
-        chunk = jnp.asarray(actions[c * CHUNK:(c + 1) * CHUNK])
-        state, out = run(state, chunk, jnp.asarray(use_policy), jax.random.key(seed + c))
-        outs.append(jax.tree.map(np.asarray, out))
-    return Rollout(*(np.concatenate(parts) for parts in zip(*outs)))
-
-
-@functools.lru_cache(maxsize=None)
-def _scripted(game_id: str, rom_dir: str) -> Rollout:
-    plan = PLANS[game_id]
-    actions = np.zeros((plan.steps, N), np.int32)
-    use_policy = np.zeros(N, bool)
-    for i, how in enumerate(plan.envs):
-        if how == "policy":
-            use_policy[i] = True
-        elif isinstance(how, str):
-            replay = np.array([int(c) for c in how], np.int32)
-            actions[:, i] = np.concatenate([replay, np.full(plan.steps - len(replay), 4, np.int32)])
-        else:
-            actions[:, i] = np.resize(np.array(how, np.int32), plan.steps)
-    return _rollout(game_id, rom_dir, actions, use_policy, seed=0)
-
-
-@functools.lru_cache(maxsize=None)
-def _random(game_id: str, rom_dir: str) -> Rollout:
-    num_actions = _compiled(game_id, rom_dir)[0].num_actions
-    actions = np.random.default_rng(1).integers(0, num_actions, (RANDOM_STEPS, N), dtype=np.int32)
-    return _rollout(game_id, rom_dir, actions, np.zeros(N, bool), seed=10_000)
+HARNESS = Harness(PLANS, autoreset=True)
+_compiled, _scripted, _random, _reset = HARNESS.compiled, HARNESS.scripted, HARNESS.random, HARNESS.reset_env0
+_reset_keys, _assert_episode_adds_up = reset_keys, assert_episode_adds_up
 
 
 @pytest.fixture(scope="module")
 def rom_dir(octax_rom_dir) -> str:
     return str(octax_rom_dir)
-
-
-def _reset(game_id: str, rom_dir: str):
-    """Env 0 after reset: (screen (32, 64) bool, registers as ints, EnvState)."""
-    env, params, reset, _ = _compiled(game_id, rom_dir)
-    obs, state = reset(_reset_keys(), params)
-    return np.asarray(obs[0, -1]).astype(bool), np.asarray(state.machine.V[0]).astype(int), state
 
 
 def _run_with_register(game_id: str, rom_dir: str, register: int, value: int, action) -> Rollout:
@@ -187,11 +96,6 @@ def _run_with_register(game_id: str, rom_dir: str, register: int, value: int, ac
     actions = np.repeat(np.resize(np.array(action, np.int32), CHUNK)[:, None], N, axis=1)
     _, out = run(state, jnp.asarray(actions), jnp.zeros(N, bool), jax.random.key(0))
     return Rollout(*jax.tree.map(np.asarray, out))
-
-
-def _assert_episode_adds_up(rollout: Rollout, i: int, end: int, start_score: float = 0.0):
-    """The rewards up to the end of env i's first episode sum to its final score."""
-    assert rollout.reward[:end + 1, i].sum() == pytest.approx(rollout.score[end, i] - start_score)
 
 
 # ---- (1) the start-up reaches gameplay, and the game answers its keys ------------------------

@@ -15,21 +15,15 @@ The tests then read the recorded rewards, flags, scores, lives, registers and 16
 
 from __future__ import annotations
 
-import dataclasses
-import functools
-from collections.abc import Callable
-
 import jax
 import jax.numpy as jnp
 import numpy as np
 import pytest
+from game_harness import Harness, N, Plan, assert_episode_adds_up
 
 import octax_core
 from octax_core.state import MEMORY_OFFSET
 
-N = 16  # envs per rollout
-CHUNK = 100  # steps per compiled scan
-RANDOM_STEPS = 1500
 GAMES = ("Missile", "Rocket", "Submarine", "Tank", "UFO", "Airplane", "Deep8", "ShootingStars",
          "FlightRunner", "Spacejam")
 RAM_WATCH = {"Tank": 0x212, "Deep8": 0x256}  # 16 bytes recorded per step; default 0x200
@@ -57,16 +51,6 @@ def _deep8_greedy(machine):
     return jnp.where(~up.any(), 0, jnp.where(bomb == 0, steer, jnp.where(bomb == 1, sink, 0)))
 
 
-@dataclasses.dataclass(frozen=True)
-class Plan:
-    """The scripted rollout: `envs[i]` drives env i (an int: that action held; "policy": the
-    closed-loop `policy`)."""
-
-    steps: int
-    envs: tuple
-    policy: Callable | None = None
-
-
 PLANS = {
     "Missile": Plan(200, (0, 1)),
     "Rocket": Plan(400, (0, 1, 1, 1, 1, 1, 1, 1)),
@@ -81,103 +65,14 @@ PLANS = {
 }
 
 
-@dataclasses.dataclass(frozen=True)
-class Rollout:
-    """Per step t and env i: reward, terminated, truncated, score, lives, and the registers,
-    watched RAM and pc after the step (frozen once the episode has ended)."""
-
-    reward: np.ndarray  # (T, N) float32
-    terminated: np.ndarray  # (T, N) bool
-    truncated: np.ndarray  # (T, N) bool
-    score: np.ndarray  # (T, N) float32
-    lives: np.ndarray  # (T, N) int32
-    V: np.ndarray  # (T, N, 16) uint8
-    ram: np.ndarray  # (T, N, 16) uint8, from RAM_WATCH
-    pc: np.ndarray  # (T, N) uint16
-
-    def first_end(self, i: int) -> int | None:
-        ends = np.flatnonzero(self.terminated[:, i])
-        return int(ends[0]) if len(ends) else None
-
-    def first_reward(self, i: int, sign: int = 1) -> int | None:
-        hits = np.flatnonzero(np.sign(self.reward[:, i]) == sign)
-        return int(hits[0]) if len(hits) else None
-
-
-@functools.cache
-def _compiled(game_id: str, rom_dir: str):
-    """make() plus the jitted batched reset and chunk runner; one compile each per game."""
-    env, params = octax_core.make(game_id, rom=rom_dir)
-    policy = PLANS[game_id].policy
-    watch = MEMORY_OFFSET + RAM_WATCH.get(game_id, 0x200)
-    step = jax.vmap(env.step, in_axes=(0, 0, 0, None))
-
-    def run(state, actions, use_policy, key):
-        def body(state, xs):
-            actions, step_key = xs
-            if policy is not None:
-                actions = jnp.where(use_policy, jax.vmap(policy)(state.machine), actions)
-            step_keys = jax.random.split(step_key, N)
-            _, state, reward, terminated, truncated, info = step(step_keys, state, actions, params)
-            machine = state.machine
-            ram = jax.lax.dynamic_slice_in_dim(machine.memory, watch, 16, axis=1)
-            flags = (reward, terminated, truncated, info["score"], info["lives"])
-            return state, (*flags, machine.V, ram, machine.pc)
-        return jax.lax.scan(body, state, (actions, jax.random.split(key, CHUNK)))
-
-    return env, params, jax.jit(jax.vmap(env.reset, in_axes=(0, None))), jax.jit(run)
-
-
-def _reset_keys():
-    return jax.vmap(lambda i: jax.random.fold_in(jax.random.key(0), i))(jnp.arange(N))
-
-
-def _rollout(game_id: str, rom_dir: str, actions: np.ndarray, use_policy: np.ndarray, seed: int) -> Rollout:
-    _, params, reset, run = _compiled(game_id, rom_dir)
-    _, state = reset(_reset_keys(), params)
-    outs = []
-    for c in range(len(actions) // CHUNK):
-        chunk = jnp.asarray(actions[c * CHUNK:(c + 1) * CHUNK])
-        state, out = run(state, chunk, jnp.asarray(use_policy), jax.random.key(seed + c))
-        outs.append(jax.tree.map(np.asarray, out))
-    return Rollout(*(np.concatenate(parts) for parts in zip(*outs)))
-
-
-@functools.cache
-def _scripted(game_id: str, rom_dir: str) -> Rollout:
-    plan = PLANS[game_id]
-    actions = np.zeros((plan.steps, N), np.int32)
-    use_policy = np.zeros(N, bool)
-    for i, how in enumerate(plan.envs):
-        if how == "policy":
-            use_policy[i] = True
-        else:
-            actions[:, i] = how
-    return _rollout(game_id, rom_dir, actions, use_policy, seed=0)
-
-
-@functools.cache
-def _random(game_id: str, rom_dir: str) -> Rollout:
-    num_actions = _compiled(game_id, rom_dir)[0].num_actions
-    actions = np.random.default_rng(1).integers(0, num_actions, (RANDOM_STEPS, N), dtype=np.int32)
-    return _rollout(game_id, rom_dir, actions, np.zeros(N, bool), seed=10_000)
+HARNESS = Harness(PLANS, autoreset=False, ram_watch=RAM_WATCH)
+_scripted, _random, _reset = HARNESS.scripted, HARNESS.random, HARNESS.reset_env0
+_assert_episode_adds_up = assert_episode_adds_up
 
 
 @pytest.fixture(scope="module")
 def rom_dir(octax_rom_dir) -> str:
     return str(octax_rom_dir)
-
-
-def _reset(game_id: str, rom_dir: str):
-    """Env 0 after reset: (screen (32, 64) bool, registers as ints, EnvState)."""
-    _, params, reset, _ = _compiled(game_id, rom_dir)
-    obs, state = reset(_reset_keys(), params)
-    return np.asarray(obs[0, -1]).astype(bool), np.asarray(state.machine.V[0]).astype(int), state
-
-
-def _assert_episode_adds_up(rollout: Rollout, i: int, end: int, start_score: float = 0.0):
-    """The rewards up to the end of env i's first episode sum to its final score."""
-    assert rollout.reward[:end + 1, i].sum() == pytest.approx(rollout.score[end, i] - start_score)
 
 
 # ---- (1) the start-up reaches gameplay, and the game answers its keys ------------------------
