@@ -173,7 +173,7 @@ class Env:
         return machine, screens
 
     def _pixels(self, screens) -> jax.Array:
-        return unpack_screen(screens).astype(jnp.uint8) * jnp.uint8(self.config.obs_scale)
+        return unpack_screen(screens, on=self.config.obs_scale, dtype=jnp.uint8)
 
     def _score(self, machine: MachineState) -> jax.Array:
         return jnp.asarray(self.spec.score_fn(machine), jnp.float32)

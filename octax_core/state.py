@@ -111,11 +111,17 @@ def boot_state(rom: Rom, key: jax.Array) -> MachineState:
     )
 
 
-def unpack_screen(screen) -> jax.Array:
-    """(..., 32, 2) packed words -> (..., 32, 64) bool pixels, row 0 at the top."""
+def unpack_screen(screen, on=True, dtype=jnp.bool_) -> jax.Array:
+    """(..., 32, 2) packed words -> (..., 32, 64) pixels, row 0 at the top.
+
+    Lit pixels read `on` in `dtype` (bool True by default; the env asks for uint8 1 or 255
+    directly, so that no bool array is made and converted on the way).
+    """
     shifts = jnp.arange(31, -1, -1, dtype=jnp.uint32)
-    bits = (screen[..., :, :, None] >> shifts) & jnp.uint32(1)
-    return bits.reshape(*screen.shape[:-1], SCREEN_WIDTH).astype(bool)
+    bits = ((screen[..., :, :, None] >> shifts) & jnp.uint32(1)).astype(dtype)
+    if dtype != jnp.bool_ and on != 1:
+        bits = bits * jnp.asarray(on, dtype)
+    return bits.reshape(*screen.shape[:-1], SCREEN_WIDTH)
 
 
 def snapshot(state: MachineState) -> dict[str, np.ndarray]:
