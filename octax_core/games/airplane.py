@@ -25,13 +25,8 @@ Start-up: 60 frames (octax: 600 instructions = 55), through the first pause into
 are cut at 4,500 steps (5 minutes); random play ends in about 750.
 """
 
-import jax.numpy as jnp
 
-from octax_core.games.spec import GameSpec
-
-
-def _v(state, i):
-    return state.V[i].astype(jnp.int32)
+from octax_core.games.spec import GameSpec, register_value
 
 
 SPECS = (GameSpec(
@@ -40,9 +35,9 @@ SPECS = (GameSpec(
     rom_file="Airplane.ch8",
     rom_sha1="fca71182a8838b686573e69b22aff945d79fe1d0",
     action_keys=(8,),
-    score_fn=lambda state: -(_v(state, 11) + _v(state, 12)),
+    score_fn=lambda state: -(register_value(state, 11) + register_value(state, 12)),
     terminated_fn=lambda state: (state.V[11] == 0) | (state.V[12] == 6),
-    lives_fn=lambda state: _v(state, 11),
+    lives_fn=lambda state: register_value(state, 11),
     startup=((0, 60),),
     quirks="chip8",
     max_episode_steps=4500,

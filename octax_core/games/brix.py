@@ -33,13 +33,8 @@ at 4,500 steps (5 minutes); one ball lasts 32-128 steps with the paddle left sti
 side, 33-303 under random play (measured).
 """
 
-import jax.numpy as jnp
 
-from octax_core.games.spec import GameSpec
-
-
-def _v(state, i):
-    return state.V[i].astype(jnp.int32)
+from octax_core.games.spec import GameSpec, register_value
 
 
 SPECS = (GameSpec(
@@ -48,9 +43,9 @@ SPECS = (GameSpec(
     rom_file="Brix [Andreas Gustafsson, 1990].ch8",
     rom_sha1="f13766c14aeb02ad8d4d103cb5eadd282d20cddc",
     action_keys=(4, 6),
-    score_fn=lambda state: _v(state, 5),
+    score_fn=lambda state: register_value(state, 5),
     terminated_fn=lambda state: (state.V[14] == 4) | (state.V[5] == 96),  # the paper's rule, plus the win
-    lives_fn=lambda state: _v(state, 14),
+    lives_fn=lambda state: register_value(state, 14),
     startup=((0, 160),),
     quirks="chip8",
     max_episode_steps=4500,

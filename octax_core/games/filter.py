@@ -23,13 +23,8 @@ first instructions), until the pipe, the counters and the paddle are drawn; each
 is drawn from the reset key. Episodes are cut at 4,500 steps (5 minutes).
 """
 
-import jax.numpy as jnp
 
-from octax_core.games.spec import GameSpec
-
-
-def _v(state, i):
-    return state.V[i].astype(jnp.int32)
+from octax_core.games.spec import GameSpec, register_value
 
 
 SPECS = (GameSpec(
@@ -38,9 +33,9 @@ SPECS = (GameSpec(
     rom_file="Filter.ch8",
     rom_sha1="ae71a7b081a947f1760cdc147759803aea45e751",
     action_keys=(4, 6),
-    score_fn=lambda state: _v(state, 14),
+    score_fn=lambda state: register_value(state, 14),
     terminated_fn=lambda state: (state.V[13] == 0) | (state.V[14] == 99),
-    lives_fn=lambda state: _v(state, 13),
+    lives_fn=lambda state: register_value(state, 13),
     startup=((0, 12),),
     quirks="chip8",
     max_episode_steps=4500,

@@ -21,13 +21,8 @@ Start-up: 10 frames (octax: 50 instructions = 5), until the 8 targets are drawn 
 frame under display wait). Episodes are cut at 2,700 steps (3 minutes); ten shots take about 150.
 """
 
-import jax.numpy as jnp
 
-from octax_core.games.spec import GameSpec
-
-
-def _v(state, i):
-    return state.V[i].astype(jnp.int32)
+from octax_core.games.spec import GameSpec, register_value
 
 
 SPECS = (GameSpec(
@@ -36,7 +31,7 @@ SPECS = (GameSpec(
     rom_file="Missile [David Winter].ch8",
     rom_sha1="0d0cc129dad3c45ba672f85fec71a668232212cc",
     action_keys=(8,),
-    score_fn=lambda state: _v(state, 7),
+    score_fn=lambda state: register_value(state, 7),
     terminated_fn=lambda state: (state.V[6] == 0) | (state.V[5] == 0),
     startup=((0, 10),),
     quirks="chip8",

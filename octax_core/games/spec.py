@@ -10,6 +10,7 @@ import dataclasses
 from typing import Callable, Optional, Union
 
 import jax
+import jax.numpy as jnp
 
 from octax_core.quirks import Quirks
 from octax_core.state import MachineState
@@ -78,6 +79,11 @@ CATEGORIES = (
     "navigation",  # Exploration & continuous navigation
     "reaction",  # Simple reaction & timing
 )
+
+
+def register_value(state: MachineState, index: int) -> jax.Array:
+    """V[index] as int32, so that score arithmetic cannot wrap around at 256 as uint8 would."""
+    return state.V[index].astype(jnp.int32)
 
 
 def key_mask(*keys: int) -> int:

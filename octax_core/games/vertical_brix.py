@@ -25,13 +25,8 @@ episode starts the same (use `noop_max` to vary the start). Episodes are cut at 
 minutes).
 """
 
-import jax.numpy as jnp
 
-from octax_core.games.spec import GameSpec, key_mask
-
-
-def _v(state, i):
-    return state.V[i].astype(jnp.int32)
+from octax_core.games.spec import GameSpec, key_mask, register_value
 
 
 SPECS = (GameSpec(
@@ -40,9 +35,9 @@ SPECS = (GameSpec(
     rom_file="Vertical Brix [Paul Robson, 1996].ch8",
     rom_sha1="da710f631f8e35534d0b9170bcf892a60f49c43d",
     action_keys=(1, 4),
-    score_fn=lambda state: _v(state, 8),
+    score_fn=lambda state: register_value(state, 8),
     terminated_fn=lambda state: state.V[7] == 0,
-    lives_fn=lambda state: _v(state, 7),
+    lives_fn=lambda state: register_value(state, 7),
     startup=((key_mask(7), 250), (0, 1)),
     quirks="chip8",
     max_episode_steps=4500,

@@ -25,13 +25,8 @@ drawn and the ROM waits for the first serve; V7 is 0 until then. Each serve's di
 drawn from the reset key. Episodes are cut at 4,500 steps (5 minutes).
 """
 
-import jax.numpy as jnp
 
-from octax_core.games.spec import GameSpec
-
-
-def _v(state, i):
-    return state.V[i].astype(jnp.int32)
+from octax_core.games.spec import GameSpec, register_value
 
 
 SPECS = (GameSpec(
@@ -40,9 +35,9 @@ SPECS = (GameSpec(
     rom_file="Wipe Off [Joseph Weisbecker].ch8",
     rom_sha1="d666688a8fce468a7d88b536bc1ef5f35ba12031",
     action_keys=(4, 6),
-    score_fn=lambda state: _v(state, 6),
+    score_fn=lambda state: register_value(state, 6),
     terminated_fn=lambda state: (state.V[7] == 0) | (state.V[6] == 112),
-    lives_fn=lambda state: _v(state, 7),
+    lives_fn=lambda state: register_value(state, 7),
     startup=((0, 60),),
     quirks="chip8",
     max_episode_steps=4500,
