@@ -29,10 +29,10 @@ BENCH_ARGS  ?=
 help:
 	@sed -n 's/^# \(make .*\)/\1/p' Makefile
 
-demo: $(VENV)/.installed-core
+demo: $(VENV)/.installed-video
 	$(PY) -m octax_core.demo
 
-test: $(VENV)/.installed-dev
+test: $(VENV)/.installed-all
 	$(PY) -m pytest $(PYTEST_ARGS)
 
 bench: $(VENV)/.installed-dev

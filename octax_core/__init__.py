@@ -5,7 +5,7 @@ See docs/machine.md for the machine contract and docs/env.md for the env API.
 """
 
 from octax_core.decode import Kind
-from octax_core.env import Env, EnvConfig, EnvParams, EnvState, make, make_params
+from octax_core.env import Env, EnvConfig, EnvParams, EnvState, make, make_config, make_params
 from octax_core.games import GameSpec, get_spec, list_games
 from octax_core.machine import Machine
 from octax_core.quirks import QUIRK_PROFILES, Quirks
@@ -15,5 +15,5 @@ from octax_core.state import FONT, FONT_ADDRESS, MachineState, poke, render_text
 __all__ = [
     "FONT", "FONT_ADDRESS", "Env", "EnvConfig", "EnvParams", "EnvState", "GameSpec", "Kind",
     "MAX_ROM_SIZE", "Machine", "MachineState", "PROGRAM_ADDRESS", "QUIRK_PROFILES", "Quirks", "Rom",
-    "get_spec", "list_games", "make", "make_params", "poke", "render_text", "snapshot",
+    "get_spec", "list_games", "make", "make_config", "make_params", "poke", "render_text", "snapshot",
 ]

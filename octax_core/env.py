@@ -151,11 +151,14 @@ class Env:
             done=terminated | truncated,
         )
         obs = self._pixels(screens)
-        info = {"score": new_state.score, "lives": self._lives(new_state.machine),
-                "episode_step": new_state.episode_step}
+        info = self.info(new_state)
         if self.config.autoreset:
             obs, new_state, info = self._autoreset(reset_key, obs, new_state, info, params)
         return obs, new_state, reward, terminated, truncated, info
+
+    def info(self, state: EnvState) -> dict[str, jax.Array]:
+        """The per-step info of one env: score, lives (-1 where the game keeps none), episode_step."""
+        return {"score": state.score, "lives": self._lives(state.machine), "episode_step": state.episode_step}
 
     # --- pieces -------------------------------------------------------------------------------
 
@@ -259,6 +262,17 @@ def make(game: Union[str, GameSpec], *, rom=None, **overrides: Any) -> tuple[Env
     >>> obs, state = env.reset(jax.random.key(0), params)            # doctest: +SKIP
     """
     spec = game if isinstance(game, GameSpec) else get_spec(game)
+    config, params = make_config(spec, **overrides)
+    return Env(spec, config, rom), params
+
+
+def make_config(spec: GameSpec, **overrides: Any) -> tuple[EnvConfig, EnvParams]:
+    """The checked `EnvConfig` and `EnvParams` that `make` would use, without booting the ROM.
+
+    Raises:
+        TypeError: an unknown override (the message lists the valid ones).
+        ValueError: an override out of range.
+    """
     unknown = set(overrides) - _CONFIG_FIELDS - _PARAM_FIELDS
     if unknown:
         raise TypeError(f"unknown override(s) {sorted(unknown)}; valid: {sorted(_CONFIG_FIELDS | _PARAM_FIELDS)}")
@@ -268,7 +282,7 @@ def make(game: Union[str, GameSpec], *, rom=None, **overrides: Any) -> tuple[Env
     config = EnvConfig(**config_args)
     _check_config(config)
     params = make_params(spec, **{k: v for k, v in overrides.items() if k in _PARAM_FIELDS})
-    return Env(spec, config, rom), params
+    return config, params
 
 
 def _check_config(config: EnvConfig) -> None:

@@ -1,5 +1,22 @@
-"""Gymnasium, Stable-Baselines3 and TorchRL adapters for the CHIP-8 core (`octax_core`).
+"""octax_gym: CHIP-8 games as Gymnasium environments over the batched JAX core (`octax_core`).
 
-Not written yet: this package is a placeholder for the Gymnasium layer, which comes in a later
-issue. It will import `octax_core`, never the reverse, and will load torch, SB3 and TorchRL lazily.
+    import gymnasium as gym
+    import octax_gym
+
+    gym.register_envs(octax_gym)                       # importing registers octax/<Game>-v0
+    env = gym.make("octax/Pong-v0", render_mode="rgb_array")
+    envs = gym.make_vec("octax/Pong-v0", num_envs=64, backend="torch")
+
+`OctaxVectorEnv` is a real `gymnasium.vector.VectorEnv` (one jitted call per step), `OctaxEnv` the
+single env. This package imports `octax_core`, never the reverse; torch, SB3 and TorchRL are
+imported only when asked for. See docs/gymnasium.md.
 """
+
+from octax_gym.env import OctaxEnv
+from octax_gym.registration import NAMESPACE, env_id, register_all
+from octax_gym.render import PALETTES
+from octax_gym.vector import OctaxVectorEnv
+
+ENV_IDS = tuple(register_all())
+
+__all__ = ["ENV_IDS", "NAMESPACE", "OctaxEnv", "OctaxVectorEnv", "PALETTES", "env_id", "register_all"]

@@ -1,8 +1,9 @@
 """The `octax-gym` command line (also `python -m octax_gym`).
 
-Each command is one `_cmd_*` function taking the parsed arguments and returning an exit status;
-`_build_parser` wires them up, one `_add_*` function per command group. Heavy imports (the game
-registry and `octax_core` pull in JAX) happen after parsing, so `octax-gym --help` stays fast.
+Each command is one `_cmd_*` function taking the parsed arguments and returning an exit status.
+`_build_parser` wires them up: the ROM store's commands are here, the others in one module each
+(`cli_games`: list, info; `cli_record`: record; `cli_bench`: bench), each adding its parsers with
+`add_commands`. Heavy work (emulation, video, torch) is imported inside the commands.
 
     octax-gym roms list                  each game's ROM: present?, verified?, where
     octax-gym roms install [--dest DIR]  get the octax==0.1.1 wheel with pip, install its ROMs
@@ -41,14 +42,20 @@ def _build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="octax-gym", description="CHIP-8 games as reinforcement-learning environments.")
     commands = parser.add_subparsers(title="commands", metavar="COMMAND")
+    # One module per command group; each imports only argparse at module level.
+    from octax_gym import cli_bench, cli_games, cli_record
+
+    cli_games.add_commands(commands)
     _add_roms(commands)
+    cli_record.add_commands(commands)
+    cli_bench.add_commands(commands)
     return parser
 
 
 def _add_roms(commands: argparse._SubParsersAction) -> None:
     roms = commands.add_parser("roms", help="list, install or import the games' ROMs",
                                description="The ROM store; see docs/roms.md.")
-    roms.set_defaults(func=_help_of(roms))
+    roms.set_defaults(func=help_of(roms))
     sub = roms.add_subparsers(title="roms commands", metavar="ACTION")
     sub.add_parser("list", help="each game's ROM: present, verified, path").set_defaults(func=_cmd_roms_list)
     install = sub.add_parser("install", help=f"download the octax=={OCTAX_VERSION} wheel with pip and "
@@ -61,14 +68,14 @@ def _add_roms(commands: argparse._SubParsersAction) -> None:
     imp.set_defaults(func=_cmd_roms_import)
 
 
-def _help_of(parser: argparse.ArgumentParser) -> Callable[[argparse.Namespace], int]:
+def help_of(parser: argparse.ArgumentParser) -> Callable[[argparse.Namespace], int]:
     def show(_args: argparse.Namespace) -> int:
         parser.print_help()
         return 2
     return show
 
 
-def _game_specs() -> list:
+def game_specs() -> list:
     """Every registered `GameSpec` (imports the registry, hence JAX)."""
     from octax_core.games import get_spec, list_games
 
@@ -78,7 +85,7 @@ def _game_specs() -> list:
 def _cmd_roms_list(args: argparse.Namespace) -> int:
     from octax_core import romstore
 
-    rows = romstore.rom_status(_game_specs())
+    rows = romstore.rom_status(game_specs())
     if not rows:
         print("no games registered")
         return 0
@@ -87,7 +94,7 @@ def _cmd_roms_list(args: argparse.Namespace) -> int:
         verified = "yes" if row.verified else ("-" if row.path is None else "NO: sha1 " + row.actual_sha1)
         table.append((row.game_id, row.rom_file, "yes" if row.path else "missing", verified,
                       str(row.path) if row.path else "-"))
-    _print_table(table)
+    print_table(table)
     n_ok = sum(row.verified for row in rows)
     print(f"\n{n_ok}/{len(rows)} ROMs present and verified. Searched: "
           + ", ".join(str(d) for d in romstore.search_dirs()))
@@ -99,7 +106,7 @@ def _cmd_roms_list(args: argparse.Namespace) -> int:
 def _cmd_roms_install(args: argparse.Namespace) -> int:
     from octax_core import romstore
 
-    specs = _game_specs()
+    specs = game_specs()
     print(f"downloading octax=={OCTAX_VERSION} with pip ...")
     results = romstore.install_from_pypi(specs, args.dest, OCTAX_VERSION)
     return _report_import(results, specs, args.dest)
@@ -108,7 +115,7 @@ def _cmd_roms_install(args: argparse.Namespace) -> int:
 def _cmd_roms_import(args: argparse.Namespace) -> int:
     from octax_core import romstore
 
-    specs = _game_specs()
+    specs = game_specs()
     return _report_import(romstore.import_roms(args.path, specs, args.dest), specs, args.dest)
 
 
@@ -134,7 +141,7 @@ def _report_import(results: list, specs: list, dest: Optional[Path]) -> int:
     return 0
 
 
-def _print_table(rows: list[tuple[str, ...]]) -> None:
+def print_table(rows: list[tuple[str, ...]]) -> None:
     widths = [max(len(row[i]) for row in rows) for i in range(len(rows[0]) - 1)]
     for row in rows:
         print("  ".join(cell.ljust(w) for cell, w in zip(row, widths)) + "  " + row[-1])

@@ -27,7 +27,7 @@ def store(tmp_path, monkeypatch):
 @pytest.fixture
 def fake_games(monkeypatch):
     specs = [make_spec("Brix", "Brix.ch8", BRIX), make_spec("Pong", "Pong (1 player).ch8", PONG)]
-    monkeypatch.setattr(cli, "_game_specs", lambda: specs)
+    monkeypatch.setattr(cli, "game_specs", lambda: specs)
     return specs
 
 

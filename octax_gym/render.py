@@ -1,0 +1,91 @@
+"""Screens to RGB frames: palettes, the OpenCV nearest-neighbour upscale, and frame grids.
+
+Host-side numpy only (no JAX, no pygame): a frame is made when someone asks for one, from the
+packed screen words the env hands over, so rendering never touches the jitted step.
+"""
+
+from __future__ import annotations
+
+from typing import Sequence, Union
+
+import cv2
+import numpy as np
+
+RGB = tuple[int, int, int]
+
+# (off, on) colours. "octo" is the Octo IDE's default pair; the rest are phosphor looks.
+PALETTES: dict[str, tuple[RGB, RGB]] = {
+    "white": ((0, 0, 0), (255, 255, 255)),
+    "octo": ((153, 102, 0), (255, 204, 0)),
+    "green": ((0, 24, 0), (51, 255, 102)),
+    "amber": ((24, 12, 0), (255, 176, 0)),
+    "blue": ((0, 0, 48), (120, 200, 255)),
+}
+DEFAULT_PALETTE = "white"
+DEFAULT_RENDER_SCALE = 8
+MAX_RENDER_SCALE = 64
+
+PaletteArg = Union[str, Sequence[Sequence[int]]]
+
+
+def resolve_palette(palette: PaletteArg) -> np.ndarray:
+    """A palette name or an (off, on) pair of RGB triples -> uint8 array (2, 3).
+
+    Raises:
+        ValueError: an unknown name (the message lists the valid ones) or a malformed pair.
+    """
+    if isinstance(palette, str):
+        if palette not in PALETTES:
+            raise ValueError(f"unknown palette {palette!r}; valid: {', '.join(PALETTES)} "
+                             "or an (off, on) pair of RGB triples")
+        return np.array(PALETTES[palette], np.uint8)
+    try:
+        colours = np.array(palette)
+    except (TypeError, ValueError):
+        colours = np.array(None)
+    if (colours.shape != (2, 3) or not np.issubdtype(colours.dtype, np.integer)
+            or colours.min() < 0 or colours.max() > 255):
+        raise ValueError(f"palette must be a name ({', '.join(PALETTES)}) or an (off, on) pair of "
+                         f"RGB triples with values 0..255, got {palette!r}")
+    return colours.astype(np.uint8)
+
+
+def check_render_scale(scale) -> int:
+    if isinstance(scale, bool) or not isinstance(scale, (int, np.integer)) or not 1 <= scale <= MAX_RENDER_SCALE:
+        raise ValueError(f"render_scale must be an int in 1..{MAX_RENDER_SCALE}, got {scale!r}")
+    return int(scale)
+
+
+def unpack_words(screen: np.ndarray) -> np.ndarray:
+    """Packed screen words (..., 32, 2) uint32 -> (..., 32, 64) bool, on the host."""
+    screen = np.asarray(screen, np.uint32)
+    big_endian = screen.astype(">u4").view(np.uint8)  # each word's top bit is the leftmost pixel
+    return np.unpackbits(big_endian, axis=-1).astype(bool)
+
+
+def to_rgb(pixels: np.ndarray, scale: int, palette: np.ndarray) -> np.ndarray:
+    """(32, 64) bool pixels -> (32*scale, 64*scale, 3) uint8, upscaled nearest-neighbour by OpenCV."""
+    small = palette[pixels.astype(np.intp)]
+    if scale == 1:
+        return np.ascontiguousarray(small)
+    height, width = pixels.shape
+    return cv2.resize(small, (width * scale, height * scale), interpolation=cv2.INTER_NEAREST)
+
+
+def tile(frames: Sequence[np.ndarray], columns: int | None = None, gap: int = 2) -> np.ndarray:
+    """Frames of one shape -> one grid image (row-major, `gap` grey pixels between cells).
+
+    The grid's sides are rounded up to even numbers, which H.264 with 4:2:0 chroma needs.
+    """
+    if not len(frames):
+        raise ValueError("tile needs at least one frame")
+    count = len(frames)
+    columns = columns or int(np.ceil(np.sqrt(count)))
+    rows = int(np.ceil(count / columns))
+    h, w, c = frames[0].shape
+    height, width = rows * h + (rows - 1) * gap, columns * w + (columns - 1) * gap
+    grid = np.full((height + height % 2, width + width % 2, c), 64, np.uint8)
+    for index, frame in enumerate(frames):
+        r, col = divmod(index, columns)
+        grid[r * (h + gap): r * (h + gap) + h, col * (w + gap): col * (w + gap) + w] = frame
+    return grid

@@ -1,0 +1,197 @@
+"""`OctaxVectorEnv`: a `gymnasium.vector.VectorEnv` over the batched JAX core.
+
+    import gymnasium as gym, octax_gym
+    gym.register_envs(octax_gym)
+    envs = gym.make_vec("octax/Pong-v0", num_envs=512)          # or OctaxVectorEnv("Pong", 512)
+    obs, info = envs.reset(seed=0)
+    obs, reward, terminated, truncated, info = envs.step(envs.action_space.sample())
+
+A step is one jitted call (key split, batched step, autoreset) with no host sync inside; the
+outputs reach numpy, JAX or torch without a copy (`backend=`). See docs/gymnasium.md.
+"""
+
+from __future__ import annotations
+
+from typing import Any, Optional, Union
+
+import gymnasium
+import jax
+import numpy as np
+from gymnasium import spaces
+from gymnasium.vector import AutoresetMode
+
+from octax_gym import backends, program, render
+from octax_gym.program import build, keys_from_seeds, seeds_for
+
+FRAMES_PER_SECOND = 60  # the CHIP-8 timer rate; a step lasts frames_per_step of these frames
+
+
+def check_autoreset_mode(mode) -> AutoresetMode:
+    if isinstance(mode, AutoresetMode):
+        return mode
+    for member in AutoresetMode:
+        if isinstance(mode, str) and mode.lower().replace("_", "") in (member.value.lower(), member.name.lower().replace("_", "")):
+            return member
+    raise ValueError(f"unknown autoreset_mode {mode!r}; valid: "
+                     + ", ".join(f"AutoresetMode.{m.name}" for m in AutoresetMode)
+                     + " (or the strings 'next_step', 'same_step', 'disabled')")
+
+
+def check_num_envs(num_envs) -> int:
+    if isinstance(num_envs, bool) or not isinstance(num_envs, (int, np.integer)) or num_envs < 1:
+        raise ValueError(f"num_envs must be a positive int, got {num_envs!r}")
+    return int(num_envs)
+
+
+class OctaxVectorEnv(gymnasium.vector.VectorEnv):
+    """`num_envs` copies of one CHIP-8 game, stepped together by one jitted JAX call.
+
+    Observation: uint8 (num_envs, frames_per_step, 32, 64), the screen after each 60 Hz frame of
+    the step, lit pixels `obs_scale` (1 or 255). Action: int per env in 0..n-1, 0 = no key, i =
+    the game's i-th key held for the whole step. Reward: change of the game's score, float32.
+    `info`: score, lives (-1 where the game keeps none), episode_step, each with its `_` mask.
+
+    Autoreset (`autoreset_mode`, Gymnasium's `AutoresetMode`):
+      NEXT_STEP (default): the step after an episode ends resets that env; its action is ignored,
+        reward 0, flags False.
+      SAME_STEP: the ending step returns the new episode's first observation; the last one is in
+        `info["final_obs"]` and its info in `info["final_info"]`, batched, rows marked by
+        `info["_final_obs"]` / `info["_final_info"]`.
+      DISABLED: ended envs stand still (same observation, reward 0, same flags) until you call
+        `reset(options={"reset_mask": mask})`.
+
+    Args:
+        game: a registered game id ("Pong"; see `octax_core.list_games()`) or a `GameSpec`.
+        num_envs: number of envs in the batch.
+        autoreset_mode: see above.
+        backend: "numpy" (default), "jax" or "torch"; arrays are handed over without copies.
+        device: where the env runs and its arrays live: None (JAX's default), "cpu", "cuda",
+            "cuda:1", a jax.Device or a torch.device.
+        render_mode: None or "rgb_array" (`render()` returns a tuple of num_envs frames).
+        frames_per_step, instructions_per_frame, obs_scale, freeze_timers: fixed at
+            construction (None = the game's default; see `octax_core.EnvConfig`).
+        max_episode_steps, repeat_action_probability, noop_max: the episode params (None = the
+            game's default; see `octax_core.EnvParams`).
+        render_scale: pixel size of a rendered frame (default 8: 512 x 256).
+        palette: a name from `octax_gym.render.PALETTES` or an (off, on) pair of RGB triples.
+        rom: an explicit ROM path (its SHA-1 must match the game's).
+    """
+
+    metadata = {"render_modes": ["rgb_array"], "autoreset_mode": AutoresetMode.NEXT_STEP,
+                "render_fps": FRAMES_PER_SECOND // 4}
+
+    def __init__(self, game: Any, num_envs: int = 1, *,
+                 autoreset_mode: Union[AutoresetMode, str] = AutoresetMode.NEXT_STEP,
+                 backend: str = "numpy", device: Any = None, render_mode: Optional[str] = None,
+                 frames_per_step: Optional[int] = None, instructions_per_frame: Optional[int] = None,
+                 obs_scale: Optional[int] = None, freeze_timers: Optional[bool] = None,
+                 max_episode_steps: Optional[int] = None, repeat_action_probability: Optional[float] = None,
+                 noop_max: Optional[int] = None, render_scale: int = render.DEFAULT_RENDER_SCALE,
+                 palette: render.PaletteArg = render.DEFAULT_PALETTE, rom=None, **unknown):
+        if unknown:
+            raise TypeError(f"OctaxVectorEnv got unknown keyword(s) {sorted(unknown)}; valid: {', '.join(KEYWORDS)}")
+        self.num_envs = check_num_envs(num_envs)
+        self.autoreset_mode = check_autoreset_mode(autoreset_mode)
+        self.backend = backends.check_backend(backend)
+        self.device = backends.resolve_device(device)
+        if render_mode not in (None, "rgb_array"):
+            raise ValueError(f"unknown render_mode {render_mode!r}; valid: None, 'rgb_array'")
+        self.render_mode = render_mode
+        self.render_scale = render.check_render_scale(render_scale)
+        self.palette = render.resolve_palette(palette)
+        self._program, params = build(game, rom, dict(
+            frames_per_step=frames_per_step, instructions_per_frame=instructions_per_frame,
+            obs_scale=obs_scale, freeze_timers=freeze_timers, max_episode_steps=max_episode_steps,
+            repeat_action_probability=repeat_action_probability, noop_max=noop_max))
+        self.core_env = self._program.env
+        self.game_spec = self.core_env.spec
+        self.params = jax.device_put(params, self.device)
+        self._step_fn = self._program.step[self.autoreset_mode]
+
+        config = self.core_env.config
+        self.metadata = {**type(self).metadata, "autoreset_mode": self.autoreset_mode,
+                         "render_fps": FRAMES_PER_SECOND / config.frames_per_step}
+        self.single_observation_space = spaces.Box(0, config.obs_scale, self.core_env.observation_shape, np.uint8)
+        self.single_action_space = spaces.Discrete(self.core_env.num_actions)
+        self.observation_space = gymnasium.vector.utils.batch_space(self.single_observation_space, self.num_envs)
+        self.action_space = gymnasium.vector.utils.batch_space(self.single_action_space, self.num_envs)
+        self._keys = self._state = self._obs = None
+
+    # --- Gymnasium API ----------------------------------------------------------------------
+
+    def reset(self, *, seed: Optional[Union[int, list[int]]] = None, options: Optional[dict] = None):
+        """Resets every env, or with `options={"reset_mask": m}` (bool numpy array (num_envs,))
+        only the rows where m is True. An int seed s seeds env i with s + i."""
+        super().reset(seed=seed if isinstance(seed, (int, np.integer)) else None)
+        options = dict(options or {})
+        mask = options.pop("reset_mask", None)
+        if options:
+            raise ValueError(f"unknown reset option(s) {sorted(options)}; valid: 'reset_mask'")
+        if mask is not None:
+            mask = self._check_mask(mask)
+        if self._state is None or seed is not None:
+            seeds = seeds_for(seed, self.num_envs, self.np_random)
+            keys = jax.device_put(keys_from_seeds(seeds), self.device)
+            if self._keys is None or mask is None:
+                self._keys = keys
+            else:
+                self._keys = program._select_keys(jax.numpy.asarray(mask), keys, self._keys)
+        if self._state is None or mask is None:
+            self._keys, self._obs, self._state, info = self._program.reset(self._keys, None, None, None, self.params)
+        else:
+            self._keys, self._obs, self._state, info = self._program.reset(
+                self._keys, self._state, self._obs, jax.device_put(mask, self.device), self.params)
+        return backends.to_backend(self._obs, self.backend), backends.to_backend(info, self.backend)
+
+    def step(self, actions):
+        """Steps every env with its action; one jitted call, no host sync inside it."""
+        if self._state is None:
+            raise gymnasium.error.ResetNeeded("call reset() before step()")
+        actions = backends.actions_to_jax(actions, self.num_envs, self.single_action_space.n, self.device,
+                                          self.game_spec.id)
+        self._keys, self._obs, self._state, reward, terminated, truncated, info = self._step_fn(
+            self._keys, self._state, actions, self.params)
+        out = backends.to_backend((self._obs, reward, terminated, truncated, info), self.backend)
+        return out
+
+    def render(self) -> Optional[tuple[np.ndarray, ...]]:
+        """One RGB frame per env (H = 32 * render_scale, W = 64 * render_scale), the current screens."""
+        if self.render_mode is None:
+            gymnasium.logger.warn("render() needs render_mode='rgb_array' at construction; returning None")
+            return None
+        if self._state is None:
+            raise gymnasium.error.ResetNeeded("call reset() before render()")
+        pixels = render.unpack_words(np.asarray(self._state.machine.screen))
+        return tuple(render.to_rgb(p, self.render_scale, self.palette) for p in pixels)
+
+    def close_extras(self, **kwargs):
+        self._keys = self._state = self._obs = None
+
+    # --- helpers ----------------------------------------------------------------------------
+
+    @property
+    def game(self) -> str:
+        return self.game_spec.id
+
+    @property
+    def state(self):
+        """The batched `octax_core.EnvState` (JAX arrays), for inspection and tools."""
+        return self._state
+
+    def _check_mask(self, mask) -> np.ndarray:
+        if not isinstance(mask, np.ndarray) or mask.dtype != np.bool_ or mask.shape != (self.num_envs,):
+            raise ValueError(f"options['reset_mask'] must be a numpy bool array of shape ({self.num_envs},), "
+                             f"got {type(mask).__name__} {getattr(mask, 'dtype', '')} {getattr(mask, 'shape', '')}")
+        if not mask.any():
+            raise ValueError("options['reset_mask'] must have at least one True row")
+        if self._state is None and not mask.all():
+            raise ValueError("the first reset() resets every env: a reset_mask must be all True or absent")
+        return mask
+
+    def __repr__(self) -> str:
+        return f"OctaxVectorEnv({self.game_spec.id}, num_envs={self.num_envs}, backend={self.backend!r})"
+
+
+KEYWORDS = ("autoreset_mode", "backend", "device", "render_mode", "frames_per_step", "instructions_per_frame",
+            "obs_scale", "freeze_timers", "max_episode_steps", "repeat_action_probability", "noop_max",
+            "render_scale", "palette", "rom")
