@@ -126,20 +126,21 @@ def _check_game(game) -> str:
     return game
 
 
-def seeds_for(seed, num_envs: int, np_random: np.random.Generator) -> list[int]:
+def seeds_for(seed, num_envs: int) -> list[int]:
     """Per-env seeds as Gymnasium's SyncVectorEnv makes them: an int s gives s, s+1, ...; a list
-    gives one per env; None draws a base seed from the env's `np_random`."""
-    if seed is None:
-        base = int(np_random.integers(0, 2**31 - num_envs))
-        return [base + i for i in range(num_envs)]
-    if isinstance(seed, (int, np.integer)) and not isinstance(seed, bool):
-        if seed < 0:
-            raise ValueError(f"seed must be a non-negative int, got {seed}")
+    gives one per env."""
+    def valid(s):
+        return isinstance(s, (int, np.integer)) and not isinstance(s, bool) and 0 <= s < MAX_SEED
+
+    if valid(seed) and seed + num_envs <= MAX_SEED:
         return [int(seed) + i for i in range(num_envs)]
-    if isinstance(seed, (list, tuple)) and len(seed) == num_envs and all(
-            isinstance(s, (int, np.integer)) and not isinstance(s, bool) and s >= 0 for s in seed):
+    if isinstance(seed, (list, tuple)) and len(seed) == num_envs and all(valid(s) for s in seed):
         return [int(s) for s in seed]
-    raise ValueError(f"seed must be None, a non-negative int, or a list of {num_envs} non-negative ints, got {seed!r}")
+    raise ValueError(f"seed must be None, an int in 0..2**32 - num_envs, or a list of {num_envs} ints in "
+                     f"0..2**32 - 1, got {seed!r}")
+
+
+MAX_SEED = 2**32  # seeds become uint32 JAX PRNG seeds
 
 
 def keys_from_seeds(seeds: list[int]) -> jax.Array:

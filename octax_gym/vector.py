@@ -122,15 +122,17 @@ class OctaxVectorEnv(gymnasium.vector.VectorEnv):
     def reset(self, *, seed: Optional[Union[int, list[int]]] = None, options: Optional[dict] = None):
         """Resets every env, or with `options={"reset_mask": m}` (bool numpy array (num_envs,))
         only the rows where m is True. An int seed s seeds env i with s + i."""
-        super().reset(seed=seed if isinstance(seed, (int, np.integer)) else None)
+        seeds = None if seed is None else seeds_for(seed, self.num_envs)  # checks the seed first
+        super().reset(seed=int(seed) if isinstance(seed, (int, np.integer)) else None)
         options = dict(options or {})
         mask = options.pop("reset_mask", None)
         if options:
             raise ValueError(f"unknown reset option(s) {sorted(options)}; valid: 'reset_mask'")
         if mask is not None:
             mask = self._check_mask(mask)
-        if self._state is None or seed is not None:
-            seeds = seeds_for(seed, self.num_envs, self.np_random)
+        if self._state is None or seeds is not None:
+            if seeds is None:  # the first reset without a seed: draw one
+                seeds = seeds_for(int(self.np_random.integers(0, 2**31 - self.num_envs)), self.num_envs)
             keys = jax.device_put(keys_from_seeds(seeds), self.device)
             if self._keys is None or mask is None:
                 self._keys = keys

@@ -1,12 +1,6 @@
-"""The functional env API on a tiny game written here, so every number below is worked by hand.
-
-The game ("Counter"): V0 is the score. Each frame, key 1 adds 1 and key 2 adds 2, then the
-screen is cleared and the digit 0 drawn at (random x, y = V0). Under the "chip8" profile the
-DXYN ends the frame, so one loop runs per frame: holding key 1 for a 4-frame step scores 4.
-The game is over when V0 >= 24.
+"""The functional env API on the Counter test game (tests/counter_game.py), so every number below
+is worked by hand: holding key 1 for a 4-frame step scores 4, the game is over when V0 >= 24.
 """
-
-import hashlib
 
 import jax
 import jax.numpy as jnp
@@ -14,36 +8,9 @@ import numpy as np
 import pytest
 
 import octax_core
-from octax_core.games.spec import GameSpec
 from octax_core.testing import check_env
 
-COUNTER_ROM = bytes.fromhex(
-    "6000"  # 200: V0 := 0
-    "6201"  # 202: V2 := 1
-    "6302"  # 204: V3 := 2
-    "E2A1"  # 206: skip unless key V2 held
-    "7001"  # 208: V0 += 1
-    "E3A1"  # 20A: skip unless key V3 held
-    "7002"  # 20C: V0 += 2
-    "C53F"  # 20E: V5 := random & 0x3F
-    "00E0"  # 210: clear
-    "A050"  # 212: I := glyph 0
-    "D505"  # 214: draw at (V5, V0), 5 rows; ends the frame (display wait)
-    "1206"  # 216: jump 206
-)
-GOAL = 24
-
-
-def _score(state):
-    return state.V[0].astype(jnp.int32)
-
-
-COUNTER = GameSpec(
-    id="Counter", title="Counter (test game)", rom_file="counter.ch8",
-    rom_sha1=hashlib.sha1(COUNTER_ROM).hexdigest(), action_keys=(1, 2), score_fn=_score,
-    terminated_fn=lambda s: s.V[0] >= GOAL, lives_fn=lambda s: jnp.maximum(GOAL - _score(s), 0),
-    category="reaction", description="Hold 1 or 2 to count up to 24.", max_episode_steps=50,
-)
+from counter_game import COUNTER, COUNTER_ROM, GOAL
 
 
 @pytest.fixture(scope="module")
