@@ -161,3 +161,36 @@ def test_jax_to_torch_wrapper(counter_rom):
     assert isinstance(obs, torch.Tensor) and obs.dtype == torch.uint8 and obs.shape == (2, 4, 32, 64)
     obs, reward, terminated, truncated, info = envs.step(torch.tensor([1, 2]))
     assert reward.tolist() == [4.0, 8.0] and terminated.dtype == torch.bool
+
+
+@pytest.mark.parametrize("mode", [AutoresetMode.NEXT_STEP, AutoresetMode.SAME_STEP])
+def test_vector_env_equals_gymnasium_sync_vector_env_over_single_envs(counter_rom, mode):
+    """Gymnasium's own SyncVectorEnv over OctaxEnv copies (seeded s, s+1, ...) is the reference.
+
+    In SAME_STEP the new episode's randomness differs (see docs/gymnasium.md), so there only
+    everything up to each env's first end must match, plus the final observations."""
+    num_envs, steps, seed = 3, 12, 2
+    kw = dict(max_episode_steps=4, repeat_action_probability=0.3)  # no no-op starts: resets equal
+    actions = random_actions(steps, num_envs, seed=5)
+    ours = OctaxVectorEnv(COUNTER, num_envs, rom=counter_rom, autoreset_mode=mode, **kw)
+    sync = gym.vector.SyncVectorEnv([lambda: OctaxEnv(COUNTER, rom=counter_rom, **kw)] * num_envs,
+                                    autoreset_mode=mode)
+    ended = np.zeros(num_envs, bool)
+    (obs_a, info_a), (obs_b, info_b) = ours.reset(seed=seed), sync.reset(seed=seed)
+    np.testing.assert_array_equal(obs_a, obs_b)
+    np.testing.assert_array_equal(info_a["score"], info_b["score"])
+    for t in range(steps):
+        obs_a, reward_a, term_a, trunc_a, info_a = ours.step(actions[t])
+        obs_b, reward_b, term_b, trunc_b, info_b = sync.step(actions[t])
+        live = ~ended if mode == AutoresetMode.SAME_STEP else np.ones(num_envs, bool)
+        np.testing.assert_array_equal(np.asarray(obs_a)[live], obs_b[live])
+        np.testing.assert_array_equal(reward_a[live], reward_b[live])
+        np.testing.assert_array_equal(term_a[live], term_b[live])
+        np.testing.assert_array_equal(trunc_a[live], trunc_b[live])
+        if mode == AutoresetMode.SAME_STEP and "final_obs" in info_b:
+            for i in np.flatnonzero(info_b["_final_obs"] & live):
+                assert info_a["_final_obs"][i]
+                np.testing.assert_array_equal(info_a["final_obs"][i], info_b["final_obs"][i])
+                assert info_a["final_info"]["score"][i] == info_b["final_info"]["score"][i]
+        ended |= np.asarray(term_b | trunc_b)
+    assert ended.all()
