@@ -1,4 +1,4 @@
-# make demo   boot a test ROM and print its screen as text
+# make demo   the games table, a random agent's steps/s on Pong, and a video of it (demo-pong.mp4)
 # make test   run the test suite
 # make bench  throughput of the core on Pong, against the octax package (benchmarks/README.md)
 #
@@ -30,7 +30,7 @@ help:
 	@sed -n 's/^# \(make .*\)/\1/p' Makefile
 
 demo: $(VENV)/.installed-video
-	$(PY) -m octax_core.demo
+	$(PY) -m octax_gym.demo
 
 test: $(VENV)/.installed-all
 	$(PY) -m pytest $(PYTEST_ARGS)
