@@ -5,6 +5,10 @@ Each command is one `_cmd_*` function taking the parsed arguments and returning 
 (`cli_games`: list, info; `cli_record`: record; `cli_bench`: bench), each adding its parsers with
 `add_commands`. Heavy work (emulation, video, torch) is imported inside the commands.
 
+    octax-gym list [--category C]        every game: Gymnasium id, category, actions, ROM status
+    octax-gym info GAME                  one game: actions and keys, spaces, quirks, timers, ROM
+    octax-gym record GAME --steps N --out FILE.mp4 [--policy random|noop] [--envs K]
+    octax-gym bench [--mode machine|env|gym] [--envs N,...] [--quick] [--no-octax]
     octax-gym roms list                  each game's ROM: present?, verified?, where
     octax-gym roms install [--dest DIR]  get the octax==0.1.1 wheel with pip, install its ROMs
     octax-gym roms import PATH [--dest DIR]   the same from a folder, zip or wheel on disk
@@ -33,7 +37,7 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
     try:
         return args.func(args)
     except (romstore.RomNotFoundError, romstore.RomHashError, romstore.RomInstallError,
-            OSError, ValueError, zipfile.BadZipFile) as exc:
+            OSError, ValueError, ImportError, zipfile.BadZipFile) as exc:
         print(f"octax-gym: error: {exc}", file=sys.stderr)
         return 1
 
