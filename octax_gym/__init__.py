@@ -19,4 +19,18 @@ from octax_gym.vector import OctaxVectorEnv
 
 ENV_IDS = tuple(register_all())
 
-__all__ = ["ENV_IDS", "NAMESPACE", "OctaxEnv", "OctaxVectorEnv", "PALETTES", "env_id", "register_all"]
+# The adapters import torch, SB3 or TorchRL: loaded on first use (`octax_gym.make_sb3_vec_env`),
+# never by `import octax_gym`.
+_LAZY = {"make_sb3_vec_env": "octax_gym.sb3", "PPO_KWARGS": "octax_gym.sb3",
+         "make_torchrl_env": "octax_gym.torchrl"}
+
+
+def __getattr__(name: str):
+    if name in _LAZY:
+        import importlib
+
+        return getattr(importlib.import_module(_LAZY[name]), name)
+    raise AttributeError(f"module 'octax_gym' has no attribute {name!r}")
+
+
+__all__ = ["ENV_IDS", "NAMESPACE", "OctaxEnv", "OctaxVectorEnv", "PALETTES", "env_id", "register_all", *_LAZY]
