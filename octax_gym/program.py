@@ -60,27 +60,27 @@ class Program:
         fresh_obs, fresh = jax.vmap(self.env.reset, in_axes=(0, None))(reset_keys, params)
         if state is not None:
             fresh_obs, fresh = _select(mask, (fresh_obs, fresh), (obs, state))
-            next_keys = _select_keys(mask, next_keys, keys)
+            next_keys = select_keys(mask, next_keys, keys)
         return next_keys, fresh_obs, fresh, self._with_masks(self.info(fresh))
 
     def _step(self, keys, state: EnvState, actions, params: EnvParams, *, mode: AutoresetMode):
         next_keys, step_keys, reset_keys = jax.vmap(advance)(keys)
         was_done = state.done
-        obs, state, reward, terminated, truncated, _ = jax.vmap(
+        obs, state, reward, terminated, truncated, info = jax.vmap(
             self.env.step, in_axes=(0, 0, 0, None))(step_keys, state, actions, params)
-        extra = {}
         if mode == AutoresetMode.NEXT_STEP:
-            # The step after an episode's end is its reset: the action is ignored, reward 0.
+            # The step after an episode's end is its reset: the action is ignored, and the core
+            # already gave the ended (standing-still) row reward 0; its flags are cleared here.
             obs, state = self._reset_where(was_done, reset_keys, obs, state, params)
-            reward = jnp.where(was_done, 0.0, reward)
             terminated, truncated = terminated & ~was_done, truncated & ~was_done
+            info = self.info(state)
         elif mode == AutoresetMode.SAME_STEP:
             ended = state.done
-            extra = {"final_obs": obs, "_final_obs": ended,
-                     "final_info": self._with_masks(self.info(state)), "_final_info": ended}
+            final = {"final_obs": obs, "_final_obs": ended,
+                     "final_info": self._with_masks(info), "_final_info": ended}
             obs, state = self._reset_where(ended, reset_keys, obs, state, params)
-        info = {**self._with_masks(self.info(state)), **extra}
-        return next_keys, obs, state, reward, terminated, truncated, info
+            return next_keys, obs, state, reward, terminated, truncated, {**self._with_masks(self.info(state)), **final}
+        return next_keys, obs, state, reward, terminated, truncated, self._with_masks(info)
 
     def _reset_where(self, mask, reset_keys, obs, state, params):
         def reset_rows(operands):
@@ -95,7 +95,8 @@ class Program:
         return {**info, **{f"_{name}": jnp.ones(value.shape[:1], jnp.bool_) for name, value in info.items()}}
 
 
-def _select_keys(mask, on_true, on_false):
+def select_keys(mask, on_true, on_false):
+    """Row-wise select between two batches of typed PRNG keys."""
     data = _select(mask, jax.random.key_data(on_true), jax.random.key_data(on_false))
     return jax.random.wrap_key_data(data, impl=jax.random.key_impl(on_true))
 

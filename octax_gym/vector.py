@@ -137,7 +137,7 @@ class OctaxVectorEnv(gymnasium.vector.VectorEnv):
             if self._keys is None or mask is None:
                 self._keys = keys
             else:
-                self._keys = program._select_keys(jax.numpy.asarray(mask), keys, self._keys)
+                self._keys = program.select_keys(jax.numpy.asarray(mask), keys, self._keys)
         if self._state is None or mask is None:
             self._keys, self._obs, self._state, info = self._program.reset(self._keys, None, None, None, self.params)
         else:
