@@ -13,7 +13,7 @@ imported only when asked for. See docs/gymnasium.md.
 """
 
 from octax_gym.env import OctaxEnv
-from octax_gym.registration import NAMESPACE, env_id, register_all
+from octax_gym.registration import NAMESPACE, env_id, register_all, register_game
 from octax_gym.render import PALETTES
 from octax_gym.vector import OctaxVectorEnv
 
@@ -33,4 +33,4 @@ def __getattr__(name: str):
     raise AttributeError(f"module 'octax_gym' has no attribute {name!r}")
 
 
-__all__ = ["ENV_IDS", "NAMESPACE", "OctaxEnv", "OctaxVectorEnv", "PALETTES", "env_id", "register_all", *_LAZY]
+__all__ = ["ENV_IDS", "NAMESPACE", "OctaxEnv", "OctaxVectorEnv", "PALETTES", "env_id", "register_all", "register_game", *_LAZY]

@@ -10,7 +10,11 @@ from __future__ import annotations
 
 import gymnasium
 
-from octax_core.games import get_spec, list_games
+import os
+from pathlib import Path
+from typing import Optional, Union
+
+from octax_core.games import GameSpec, get_spec, list_games
 
 NAMESPACE = "octax"
 
@@ -37,3 +41,32 @@ def register_all() -> list[str]:
         )
         ids.append(gym_id)
     return ids
+
+
+def register_game(spec: GameSpec, rom: Optional[Union[str, os.PathLike]] = None) -> str:
+    """Registers your own game (a `GameSpec` not in the core registry) as `octax/<id>-v<version>`.
+
+    Afterwards `gymnasium.make(id)` and `gymnasium.make_vec(id, num_envs=N)` build it like any
+    built-in game. `rom` is the path of its ROM file (its SHA-1 must be `spec.rom_sha1`); without
+    it the ROM store looks `spec.rom_file` up (OCTAX_ROM_DIR, the user folder, roms/).
+
+    Returns the Gymnasium id. Raises ValueError when the id is a built-in game's (pick another
+    `GameSpec.id`), FileNotFoundError when `rom` does not exist.
+    """
+    if not isinstance(spec, GameSpec):
+        raise TypeError(f"register_game expects a GameSpec, got {type(spec).__name__}")
+    if spec.id in list_games() and get_spec(spec.id) is not spec:
+        raise ValueError(f"{spec.id!r} is a built-in game's id; give your GameSpec another id "
+                         f"(built-in ids: {', '.join(list_games())})")
+    if rom is not None and not Path(rom).is_file():
+        raise FileNotFoundError(f"ROM file not found: {rom}")
+    gym_id = f"{NAMESPACE}/{spec.id}-v{spec.version}"
+    gymnasium.register(
+        id=gym_id,
+        entry_point="octax_gym.env:OctaxEnv",
+        vector_entry_point="octax_gym.vector:OctaxVectorEnv",
+        kwargs={"game": spec, "rom": None if rom is None else str(rom)},
+        max_episode_steps=None,
+        disable_env_checker=False,
+    )
+    return gym_id
