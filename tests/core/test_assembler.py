@@ -222,3 +222,43 @@ def _statement(draw) -> tuple[str, str]:
 def test_random_programs_assemble_to_their_encodings(statements, separator):
     source = ": main" + separator + separator.join(text for text, _ in statements)
     assert assemble(source).hex() == "".join(code for _, code in statements)
+
+
+# ---- semantics: the emitted sequences do what the Octo source says, on the reference machine ----
+
+_OPERATORS = {"==": lambda a, b: a == b, "!=": lambda a, b: a != b, "<": lambda a, b: a < b,
+              ">": lambda a, b: a > b, "<=": lambda a, b: a <= b, ">=": lambda a, b: a >= b}
+
+
+def _run_reference(rom: bytes, instructions: int = 200) -> list[int]:
+    from reference import RefMachine
+
+    machine = RefMachine(rom, "chip8")
+    for _ in range(instructions):
+        machine.execute(0)
+    return machine.V
+
+
+@settings(max_examples=120, deadline=None)
+@given(st.integers(0, 255), st.integers(0, 255), st.sampled_from(sorted(_OPERATORS)),
+       st.booleans())
+def test_conditions_branch_as_python_compares(a, b, operator, immediate):
+    operand = str(b) if immediate else "v2"
+    source = f"""
+    : main
+      v1 := {a}  v2 := {b}  v3 := 0  v6 := 0
+      if v1 {operator} {operand} then v3 := 1
+      if v1 {operator} {operand} begin v4 := 1 else v4 := 2 end
+      loop
+        while v1 {operator} {operand}
+        v6 += 1
+        if v6 == 3 then jump done
+      again
+    : done
+      jump done
+    """
+    V = _run_reference(assemble(source))
+    holds = _OPERATORS[operator](a, b)
+    assert V[3] == int(holds)
+    assert V[4] == (1 if holds else 2)
+    assert V[6] == (3 if holds else 0)  # while exits the loop as soon as the condition fails
