@@ -2,13 +2,15 @@
 
 Each command is one `_cmd_*` function taking the parsed arguments and returning an exit status.
 `_build_parser` wires them up: the ROM store's commands are here, the others in one module each
-(`cli_games`: list, info; `cli_record`: record; `cli_bench`: bench), each adding its parsers with
-`add_commands`. Heavy work (emulation, video, torch) is imported inside the commands.
+(`cli_games`: list, info; `cli_record`: record; `cli_bench`: bench; `cli_octo`: asm, disasm), each
+adding its parsers with `add_commands`. Heavy work (emulation, video, torch) is imported inside the commands.
 
     octax-gym list [--category C]        every game: Gymnasium id, category, actions, ROM status
     octax-gym info GAME                  one game: actions and keys, spaces, quirks, timers, ROM
     octax-gym record GAME --steps N --out FILE.mp4 [--policy random|noop] [--envs K]
     octax-gym bench [--mode machine|env|gym] [--envs N,...] [--quick] [--no-octax]
+    octax-gym asm FILE.8o [-o FILE.ch8]  assemble Octo source into a ROM (docs/octo.md)
+    octax-gym disasm FILE.ch8 [-o FILE.8o]   a ROM back to Octo source that reassembles to it
     octax-gym roms list                  each game's ROM: present?, verified?, where
     octax-gym roms install [--dest DIR]  get the octax==0.1.1 wheel with pip, install its ROMs
     octax-gym roms import PATH [--dest DIR]   the same from a folder, zip or wheel on disk
@@ -47,12 +49,13 @@ def _build_parser() -> argparse.ArgumentParser:
         prog="octax-gym", description="CHIP-8 games as reinforcement-learning environments.")
     commands = parser.add_subparsers(title="commands", metavar="COMMAND")
     # One module per command group; each imports only argparse at module level.
-    from octax_gym import cli_bench, cli_games, cli_record
+    from octax_gym import cli_bench, cli_games, cli_octo, cli_record
 
     cli_games.add_commands(commands)
     _add_roms(commands)
     cli_record.add_commands(commands)
     cli_bench.add_commands(commands)
+    cli_octo.add_commands(commands)
     return parser
 
 
