@@ -1,6 +1,7 @@
 # make demo   the games table, a random agent's steps/s on Pong, and a video of it (demo-pong.mp4)
 # make test   run the test suite
 # make bench  throughput of the core on Pong, against the octax package (benchmarks/README.md)
+# make roms   rebuild our own games, roms/*.ch8, from their Octo source roms/*.8o
 #
 # Each target creates .venv when it is missing and installs what it needs into it once: a stamp
 # file per extra (.venv/.installed-<extra>) is redone only when pyproject.toml changes.
@@ -24,7 +25,7 @@ export OCTAX_ROM_DIR ?= ../shared/roms/octax
 PYTEST_ARGS ?= -n 2 --dist loadfile
 BENCH_ARGS  ?=
 
-.PHONY: help demo test bench clean
+.PHONY: help demo test bench roms clean
 
 help:
 	@sed -n 's/^# \(make .*\)/\1/p' Makefile
@@ -37,6 +38,11 @@ test: $(VENV)/.installed-all
 
 bench: $(VENV)/.installed-dev
 	$(PY) benchmarks/throughput.py $(BENCH_ARGS)
+
+# tests/core/test_own_roms.py checks that the committed ROMs are what this builds; a game's
+# GameSpec names its ROM's SHA-1, so update it after a rebuild that changes the bytes.
+roms: $(VENV)/.installed-core
+	for source in roms/*.8o; do $(PY) -m octax_gym asm $$source || exit 1; done
 
 $(PY):
 	$(PYTHON) -m venv $(VENV)

@@ -220,7 +220,8 @@ class _Assembler:
 
     def check_name(self, name: str, kind: str) -> str:
         if name.startswith("OCTO_") or name in RESERVED_WORDS:
-            raise self.stream.error(f"the name '{name}' is reserved and cannot be used for a {kind}")
+            article = "an" if kind[0] in "aeiou" else "a"
+            raise self.stream.error(f"the name '{name}' is reserved and cannot be used for {article} {kind}")
         return name
 
     def string(self, what: str) -> Token:

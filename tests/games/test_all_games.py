@@ -1,5 +1,6 @@
-"""Every registered game: the registry holds the issue's ids, each passes the env contract suite,
-and each level family member survives random play (the per-group files cover the rest)."""
+"""Every registered game: the registry holds the issue's ids and our own games', each passes the
+env contract suite, and each level family member survives random play (the per-group files and
+test_own_games.py cover the rest)."""
 
 import jax
 import numpy as np
@@ -8,7 +9,7 @@ import pytest
 import octax_core
 from octax_core.testing import check_env
 
-EXPECTED_IDS = sorted(
+PAPER_IDS = (
     ["Airplane", "Blinky", "Brix", "Deep8", "Filter", "FlightRunner", "Missile", "Pong", "Rocket",
      "ShootingStars", "Spacejam", "Squash", "Submarine", "Tank", "Tetris", "UFO", "VerticalBrix",
      "WipeOff", "Worm"]
@@ -16,6 +17,9 @@ EXPECTED_IDS = sorted(
     + [f"SpaceFlight{i}" for i in range(1, 11)]
     + [f"TargetShooter{i}" for i in range(1, 4)]
 )
+# Our own games (roms/*.8o), each in three levels plus the plain id (its middle level).
+OWN_IDS = ["Dodge", "Dodge1", "Dodge2", "Dodge3", "Flak", "Flak1", "Flak2", "Flak3"]
+EXPECTED_IDS = sorted(PAPER_IDS + OWN_IDS)
 # test_games_levels.py plays Cavern1, SpaceFlight1 and TargetShooter1 at random; these are the others.
 OTHER_LEVELS = [g for g in EXPECTED_IDS if g.startswith(("Cavern", "SpaceFlight", "TargetShooter"))
                 and g not in ("Cavern1", "SpaceFlight1", "TargetShooter1")]

@@ -14,6 +14,7 @@ from octax_core.games import list_games
 from octax_gym import cli
 
 PONG, BRIX = b"\x00\xe0pong", b"\x00\xe0brix"
+PROJECT_ROM_DIR = romstore.PROJECT_ROM_DIR  # our own games' ROMs (roms/), hidden by `store`
 
 
 @pytest.fixture(autouse=True)
@@ -114,6 +115,7 @@ def test_python_dash_m_runs_the_cli():
 @pytest.mark.skipif(not list_games(), reason="no games registered yet")
 def test_roms_list_with_the_real_registry_and_shared_roms(octax_rom_dir, capsys, monkeypatch):
     monkeypatch.setenv("OCTAX_ROM_DIR", str(octax_rom_dir))
+    monkeypatch.setattr(romstore, "PROJECT_ROM_DIR", PROJECT_ROM_DIR)
     assert cli.main(["roms", "list"]) == 0
     n = len(list_games())
     assert f"{n}/{n} ROMs present and verified" in capsys.readouterr().out
