@@ -9,6 +9,7 @@ adding its parsers with `add_commands`. Heavy work (emulation, video, torch) is 
     octax-gym info GAME                  one game: actions and keys, spaces, quirks, timers, ROM
     octax-gym record GAME --steps N --out FILE.mp4 [--policy random|noop] [--envs K]
     octax-gym bench [--mode machine|env|gym] [--envs N,...] [--quick] [--no-octax]
+    octax-gym trace GAME|ROM [--steps N] [--blind] [--plot FILE.png]   registers: score, lives, game over?
     octax-gym asm FILE.8o [-o FILE.ch8]  assemble Octo source into a ROM (docs/octo.md)
     octax-gym disasm FILE.ch8 [-o FILE.8o]   a ROM back to Octo source that reassembles to it
     octax-gym roms list                  each game's ROM: present?, verified?, where
@@ -49,13 +50,14 @@ def _build_parser() -> argparse.ArgumentParser:
         prog="octax-gym", description="CHIP-8 games as reinforcement-learning environments.")
     commands = parser.add_subparsers(title="commands", metavar="COMMAND")
     # One module per command group; each imports only argparse at module level.
-    from octax_gym import cli_bench, cli_games, cli_octo, cli_record
+    from octax_gym import cli_bench, cli_games, cli_octo, cli_record, cli_trace
 
     cli_games.add_commands(commands)
     _add_roms(commands)
     cli_record.add_commands(commands)
     cli_bench.add_commands(commands)
     cli_octo.add_commands(commands)
+    cli_trace.add_commands(commands)
     return parser
 
 
