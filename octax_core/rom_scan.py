@@ -13,6 +13,7 @@ import dataclasses
 
 import numpy as np
 
+from octax_core.octo.disassembler import reachable_instructions
 from octax_core.rom import PROGRAM_ADDRESS
 
 NUM_REGISTERS = 16
@@ -53,32 +54,8 @@ def rom_facts(rom: bytes) -> RomFacts:
 def reachable_code(rom: bytes) -> list[int]:
     """Addresses of the instructions reachable from 0x200, following jumps, calls and skips.
 
-    Data between routines (sprites, maps) is never decoded, and an FX33 at an odd address is
-    still found. BNNN (a computed jump) ends a path: its targets are unknown.
+    The disassembler's flow analysis (`reachable_instructions`): data between routines (sprites,
+    maps) is never decoded, an FX33 at an odd address is still found, and BNNN (a computed jump),
+    `return` and words that are no instruction end a path.
     """
-    end = PROGRAM_ADDRESS + len(rom) - 1
-    memory = bytes(PROGRAM_ADDRESS) + bytes(rom)
-    seen, todo = set(), [PROGRAM_ADDRESS]
-    while todo:
-        address = todo.pop()
-        while address not in seen and PROGRAM_ADDRESS <= address < end:
-            seen.add(address)
-            op = memory[address] << 8 | memory[address + 1]
-            kind = op >> 12
-            if kind == 0x1:
-                address = op & 0xFFF
-                continue
-            if op in (0x00EE, 0x00FD) or kind == 0xB:
-                break
-            if kind == 0x2:
-                todo.append(op & 0xFFF)
-            if _is_skip(op):
-                todo.append(address + 4)
-            address += 2
-    return sorted(seen)
-
-
-def _is_skip(op: int) -> bool:
-    kind = op >> 12
-    return kind in (0x3, 0x4) or (kind in (0x5, 0x9) and op & 0xF == 0) \
-        or (kind == 0xE and op & 0xFF in (0x9E, 0xA1))
+    return sorted(reachable_instructions(bytes(rom)))

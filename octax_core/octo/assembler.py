@@ -252,6 +252,14 @@ class _Assembler:
             raise self.stream.error(f"the value {number} does not fit in {text}")
         return number & high
 
+    def known_value(self, token: Token, bits: int) -> Optional[int]:
+        """A number or defined constant (labels above this line included), range-checked to
+        `bits`; None for any other name, which each caller treats in its own way."""
+        if token.is_number:
+            return self.in_range(token.value, bits)
+        value = self.constants.get(token.value)
+        return None if value is None else self.in_range(value, bits)
+
     def value_fail(self, what: str, token: Token, undefined: bool) -> None:
         text = token.value
         if self.register_index(text) is not None:
@@ -266,22 +274,18 @@ class _Assembler:
     def small_value(self, bits: int) -> int:
         """A 4- or 8-bit operand: a number or a constant (never a forward reference)."""
         token = self.stream.next(f"{_article(bits)} {bits}-bit value")
-        if token.is_number:
-            return self.in_range(token.value, bits)
-        value = self.constants.get(token.value)
+        value = self.known_value(token, bits)
         if value is not None:
-            return self.in_range(value, bits)
+            return value
         self.value_fail(f"{_article(bits)} {bits}-bit", token, True)
         raise AssertionError("unreachable")
 
     def address_value(self) -> int:
         """A 12-bit operand: a number, a constant or label, or a label defined later."""
         token = self.stream.next("an address (a number or a label)")
-        if token.is_number:
-            return self.in_range(token.value, 12)
-        value = self.constants.get(token.value)
+        value = self.known_value(token, 12)
         if value is not None:
-            return self.in_range(value, 12)
+            return value
         self.value_fail("a 12-bit", token, False)
         self.refer_forward(token, self.here, is_long=False)
         return 0
@@ -289,11 +293,9 @@ class _Assembler:
     def long_value(self, forward_ok: bool, offset: int) -> int:
         """A 16-bit operand; forward references are patched at here + offset."""
         token = self.stream.next("a 16-bit value")
-        if token.is_number:
-            return self.in_range(token.value, 16)
-        value = self.constants.get(token.value)
+        value = self.known_value(token, 16)
         if value is not None:
-            return self.in_range(value, 16)
+            return value
         self.value_fail("a 16-bit", token, False)
         if not forward_ok:
             self.check_name(token.value, "label")

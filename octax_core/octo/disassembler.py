@@ -179,7 +179,7 @@ def disassemble(rom: RomLike) -> str:
         FileNotFoundError: no file at that path.
     """
     data = _rom_bytes(rom)
-    code = _layout(data, _reachable(data))
+    code = _layout(data, reachable_instructions(data))
     trampoline = _trampoline_target(data, code)
     labels = _labels(data, code, trampoline)
     return _render(data, code, labels, trampoline)
@@ -194,8 +194,12 @@ def _rom_bytes(rom: RomLike) -> bytes:
     return Rom.load(rom).data
 
 
-def _reachable(rom: bytes) -> dict[int, Instruction]:
-    """Every instruction that execution from 0x200 can reach, by address (they may overlap)."""
+def reachable_instructions(rom: bytes) -> dict[int, Instruction]:
+    """Every instruction that execution from 0x200 can reach, by address (they may overlap).
+
+    The code/data split of the disassembly, and the static half of `octax-gym trace`
+    (`octax_core.rom_scan`), which must never read sprite bytes as instructions.
+    """
     found: dict[int, Instruction] = {}
     pending = [PROGRAM_ADDRESS]
     while pending:
