@@ -91,6 +91,16 @@ def game_specs() -> list:
     return [get_spec(game_id) for game_id in list_games()]
 
 
+def lookup_spec(name: str):
+    """The spec for a game id or Gymnasium id, exact first, then ignoring case; None if unknown."""
+    from octax_core.games import get_spec, list_games
+    from octax_gym.registration import env_id
+
+    names = {game: game for game in list_games()} | {env_id(game): game for game in list_games()}
+    game = names.get(name) or {key.lower(): value for key, value in names.items()}.get(name.lower())
+    return None if game is None else get_spec(game)
+
+
 def _cmd_roms_list(args: argparse.Namespace) -> int:
     from octax_core import romstore
 

@@ -63,9 +63,10 @@ def _cmd_info(args: argparse.Namespace) -> int:
     from octax_core import romstore
     from octax_core.env import EnvConfig
     from octax_core.quirks import resolve_quirks
+    from octax_gym.cli import lookup_spec
     from octax_gym.registration import env_id
 
-    spec = _lookup(args.game)
+    spec = lookup_spec(args.game)
     if spec is None:
         from octax_core.games import list_games
 
@@ -106,16 +107,6 @@ def _cmd_info(args: argparse.Namespace) -> int:
     if not status.verified:
         print(f"To fix: {romstore.FIX_HINT}.")
     return 0
-
-
-def _lookup(name: str):
-    """The spec for a game id or Gymnasium id, exact first, then ignoring case; None if unknown."""
-    from octax_core.games import get_spec, list_games
-    from octax_gym.registration import env_id
-
-    names = {game: game for game in list_games()} | {env_id(game): game for game in list_games()}
-    game = names.get(name) or {key.lower(): value for key, value in names.items()}.get(name.lower())
-    return None if game is None else get_spec(game)
 
 
 def _action_rows(action_keys: tuple[int, ...]) -> list[str]:

@@ -79,13 +79,12 @@ def _resolve(name: str):
     Raises:
         ValueError: neither; the message lists the valid ids.
     """
-    from octax_core.games import get_spec, list_games
-    from octax_gym.registration import env_id
+    from octax_core.games import list_games
+    from octax_gym.cli import lookup_spec
 
-    names = {game: game for game in list_games()} | {env_id(game): game for game in list_games()}
-    game = names.get(name) or {key.lower(): value for key, value in names.items()}.get(name.lower())
-    if game is not None:
-        return get_spec(game), None
+    spec = lookup_spec(name)
+    if spec is not None:
+        return spec, None
     if Path(name).is_file():
         return None, Path(name)
     raise ValueError(f"unknown game {name!r} and no ROM file at that path; valid ids: {', '.join(list_games())} "

@@ -11,7 +11,7 @@ import pytest
 from octax_core import env as core_env
 from octax_core import romstore
 from octax_core.games import CATEGORIES, get_spec, list_games
-from octax_gym import cli, cli_games, env_id
+from octax_gym import cli, env_id
 
 
 @pytest.fixture
@@ -113,7 +113,7 @@ def test_info_shows_lives_frozen_timers_and_startup_keys(capsys):
 
 def test_info_shows_frozen_timers(monkeypatch, capsys):
     frozen = dataclasses.replace(get_spec("Pong"), freeze_timers=True)  # no registered game freezes them
-    monkeypatch.setattr(cli_games, "_lookup", lambda name: frozen)
+    monkeypatch.setattr(cli, "lookup_spec", lambda name: frozen)
     assert cli.main(["info", "Pong"]) == 0
     assert "timers:            frozen: delay and sound zeroed after every step" in capsys.readouterr().out
 
