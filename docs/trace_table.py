@@ -1,7 +1,7 @@
 """Prints the suite results of docs/trace.md: `OCTAX_ROM_DIR=../shared/roms/octax python docs/trace_table.py`.
 
-For every registered game, `octax_core.trace` plays 2000 steps x 8 envs with a random agent
-in three modes and `octax_core.trace_rank` ranks the registers; each table compares the top 3
+For every registered game, `octax_core.tools.trace` plays 2000 steps x 8 envs with a random agent
+in three modes and `octax_core.tools.trace_rank` ranks the registers; each table compares the top 3
 candidates of one role with the registers the paper's appendix names.
 
 - spec: the registered game, with its reward and termination (the reward is the score register's
@@ -19,9 +19,9 @@ import argparse
 import re
 
 import octax_core
-from octax_core import romstore
-from octax_core.trace import raw_rom_spec, record_trace
-from octax_core.trace_rank import ROLES, rank_registers
+from octax_core.env import romstore
+from octax_core.tools.trace import raw_rom_spec, record_trace
+from octax_core.tools.trace_rank import ROLES, rank_registers
 
 MODES = ("spec", "blind", "raw")
 # The paper's registers (appendix, Game List), per game family (levels share them). Lives: the

@@ -1,29 +1,32 @@
-"""octax_core: a jitted, batched CHIP-8 machine in JAX (pure JAX + numpy), the game registry and
-a functional, Gymnax-style env API over it, and the Octo assembler and disassembler
-(`assemble`, `disassemble`).
+"""octax_core: CHIP-8 games as jitted, batched RL environments in pure JAX + numpy.
 
-See docs/machine.md for the machine contract and docs/env.md for the env API.
+Three layers, each a subpackage that imports only the ones before it:
+
+* `octax_core.emulator`: the CHIP-8 machine (state pytree, decode, ops, cpu, `Machine`);
+* `octax_core.env`: the game registry, the ROM store and the functional, Gymnax-style env API;
+* `octax_core.tools`: the Octo assembler and disassembler, and the register tracer.
+
+The names below are the public API. See docs/machine.md (the machine) and docs/env.md (the envs).
 """
 
-from octax_core.decode import Kind
-from octax_core.env import Env, EnvConfig, EnvParams, EnvState, make, make_config, make_params
-from octax_core.games import GameSpec, get_spec, list_games
-from octax_core.machine import Machine
-from octax_core.octo import AssemblyError, assemble
-from octax_core.quirks import QUIRK_PROFILES, Quirks
-from octax_core.rom import MAX_ROM_SIZE, PROGRAM_ADDRESS, Rom
-from octax_core.state import FONT, FONT_ADDRESS, MachineState, poke, render_text, snapshot
+from octax_core.emulator import (FONT, FONT_ADDRESS, MAX_ROM_SIZE, PROGRAM_ADDRESS, QUIRK_PROFILES, Kind, Machine,
+                                 MachineState, Quirks, Rom, poke, render_text, snapshot)
+from octax_core.env import (Env, EnvConfig, EnvParams, EnvState, GameSpec, get_spec, list_games, make, make_config,
+                            make_params)
+from octax_core.env.testing import check_env
+from octax_core.tools.octo import AssemblyError, assemble
 
 __all__ = [
     "AssemblyError", "FONT", "FONT_ADDRESS", "Env", "EnvConfig", "EnvParams", "EnvState", "GameSpec", "Kind",
     "MAX_ROM_SIZE", "Machine", "MachineState", "PROGRAM_ADDRESS", "QUIRK_PROFILES", "Quirks", "Rom",
-    "assemble", "disassemble", "get_spec", "list_games", "make", "make_config", "make_params", "poke", "render_text", "snapshot",
+    "assemble", "check_env", "disassemble", "get_spec", "list_games", "make", "make_config", "make_params", "poke",
+    "render_text", "snapshot",
 ]
 
 
 def __getattr__(name):
     # The disassembler loads on first use (`octax_core.disassemble`), like optional extras do.
     if name == "disassemble":
-        from octax_core.octo.disassembler import disassemble
+        from octax_core.tools.octo.disassembler import disassemble
         return disassemble
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

@@ -24,9 +24,9 @@ import numpy as np
 from tqdm import tqdm
 
 import octax_gym
-from octax_core import romstore
+from octax_core.env import romstore
 from octax_gym import video
-from octax_gym.cli import game_specs, print_table
+from octax_gym.cli.common import game_specs, print_table
 
 GAME = "Pong"
 VIDEO_ENVS = 4  # a 2 x 2 grid: large enough to show that the games differ, small enough to watch

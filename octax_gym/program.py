@@ -25,8 +25,8 @@ import numpy as np
 from gymnasium.vector import AutoresetMode
 
 import octax_core
-from octax_core.env import Env, EnvConfig, EnvParams, EnvState
-from octax_core.games import GameSpec
+from octax_core.env.environment import Env, EnvConfig, EnvParams, EnvState
+from octax_core.env.games import GameSpec
 
 
 def advance(key: jax.Array) -> tuple[jax.Array, jax.Array, jax.Array]:

@@ -14,7 +14,7 @@ import os
 from pathlib import Path
 from typing import Optional, Union
 
-from octax_core.games import GameSpec, get_spec, list_games
+from octax_core.env.games import GameSpec, get_spec, list_games
 
 NAMESPACE = "octax"
 

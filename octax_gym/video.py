@@ -27,7 +27,7 @@ import numpy as np
 from tqdm import tqdm
 
 import octax_gym
-from octax_core.games import list_games
+from octax_core.env.games import list_games
 from octax_gym import render
 
 VIDEO_EXTRA_HINT = "pip install 'octax-gym[video]'"

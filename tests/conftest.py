@@ -46,6 +46,20 @@ def jit_execute():
 
 
 @pytest.fixture(scope="session")
+def counter_rom(tmp_path_factory) -> Path:
+    """The Counter test game (tests/counter_game.py) as a ROM file, written once per session.
+
+    Envs of one (game, config, ROM) share one compiled program (octax_gym caches it), so tests
+    that build envs with the same keywords pay for the compile once per worker.
+    """
+    from counter_game import COUNTER_ROM
+
+    path = tmp_path_factory.mktemp("counter") / "counter.ch8"
+    path.write_bytes(COUNTER_ROM)
+    return path
+
+
+@pytest.fixture(scope="session")
 def test_suite_dir() -> Path:
     if not TEST_SUITE_DIR.is_dir():
         pytest.fail(f"the CHIP-8 test suite is missing: expected {TEST_SUITE_DIR} (../shared beside the repo)")

@@ -10,7 +10,7 @@ import hashlib
 
 import jax.numpy as jnp
 
-from octax_core.games.spec import GameSpec
+from octax_core.env.games.spec import GameSpec
 
 COUNTER_ROM = bytes.fromhex(
     "6000"  # 200: V0 := 0

@@ -6,7 +6,7 @@ from __future__ import annotations
 import hashlib
 from pathlib import Path
 
-from octax_core.games.spec import GameSpec
+from octax_core.env.games.spec import GameSpec
 
 
 def sha1(data: bytes) -> str:

@@ -16,7 +16,7 @@ import pytest
 sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "examples"))
 import train_jax_ppo as ppo  # noqa: E402
 
-from counter_game import COUNTER, COUNTER_ROM  # noqa: E402
+from counter_game import COUNTER  # noqa: E402
 
 TINY = ppo.Config(num_envs=8, num_steps=8, num_minibatches=2, update_epochs=2, total_steps=8 * 8 * 3,
                   eval_every=0, eval_envs=4, env_overrides=(("max_episode_steps", 10),))
@@ -24,13 +24,6 @@ TINY = ppo.Config(num_envs=8, num_steps=8, num_minibatches=2, update_epochs=2, t
 # the best policy (always 2) scores 8 * 8 = 64 and a uniform one 32 on average.
 ENDLESS = dataclasses.replace(COUNTER, id="CounterEndless", terminated_fn=lambda s: jnp.bool_(False),
                               max_episode_steps=8)
-
-
-@pytest.fixture(scope="module")
-def counter_rom(tmp_path_factory):
-    path = tmp_path_factory.mktemp("counter") / "counter.ch8"
-    path.write_bytes(COUNTER_ROM)
-    return path
 
 
 def test_network_shapes():

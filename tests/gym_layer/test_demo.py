@@ -15,7 +15,7 @@ import cv2
 import pytest
 
 import octax_gym
-from octax_core import romstore
+from octax_core.env import romstore
 from octax_gym import demo
 
 

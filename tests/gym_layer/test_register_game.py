@@ -10,7 +10,7 @@ import pytest
 
 import octax_core
 import octax_gym
-from octax_core.games.spec import register_value
+from octax_core.env.games.spec import register_value
 
 # Holding key 5 counts V5 up; at 10 the game sets VE (game over) and stops counting.
 SOURCE = """

@@ -11,7 +11,7 @@ from octax_gym import OctaxEnv, OctaxVectorEnv, render
 
 
 def screens_of(envs) -> np.ndarray:
-    return np.asarray(octax_core.state.unpack_screen(envs.state.machine.screen))
+    return np.asarray(octax_core.emulator.state.unpack_screen(envs.state.machine.screen))
 
 
 def test_vector_render_is_a_tuple_of_upscaled_frames(counter_rom):
@@ -52,7 +52,7 @@ def test_custom_palette_pair():
 
 def test_unpack_words_matches_the_core():
     words = np.random.default_rng(0).integers(0, 2**32, size=(5, 32, 2), dtype=np.uint64).astype(np.uint32)
-    np.testing.assert_array_equal(render.unpack_words(words), np.asarray(octax_core.state.unpack_screen(words)))
+    np.testing.assert_array_equal(render.unpack_words(words), np.asarray(octax_core.emulator.state.unpack_screen(words)))
 
 
 def test_tile_makes_an_even_sided_grid():

@@ -1,0 +1,94 @@
+"""`GameSpec`: everything that turns a CHIP-8 ROM into an RL environment, as one frozen value.
+
+A spec is pure data plus small pure functions of the machine state; it knows nothing of the env
+API (`octax_core.env.environment`) that runs it. Each game module in this package exports its specs.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from typing import Callable, Optional, Union
+
+import jax
+import jax.numpy as jnp
+
+from octax_core.emulator.quirks import Quirks
+from octax_core.emulator.state import MachineState
+
+StateFn = Callable[[MachineState], jax.Array]
+
+
+@dataclasses.dataclass(frozen=True)
+class GameSpec:
+    """One game as an environment.
+
+    Attributes:
+        id: registry id, e.g. "Pong" (Gymnasium id `octax/Pong-v0`).
+        title: human title, e.g. "Pong (1 player)".
+        rom_file: file name of the ROM in the ROM store.
+        rom_sha1: SHA-1 of the ROM bytes; a ROM with another hash is refused.
+        action_keys: CHIP-8 key held by actions 1..k (action 0 is no-op).
+        score_fn: state -> score (int32 or float32 scalar); the reward is its change per step.
+        terminated_fn: state -> bool scalar, true once the game is over.
+        lives_fn: state -> lives left (int32), where the game keeps a count; else None.
+        startup: (key mask, frames) pairs run once after boot to get past menus; the resulting
+            state is the template every reset starts from.
+        quirks: the interpreter profile this ROM plays correctly under.
+        freeze_timers: zero the delay and sound timers after every env step, as the octax
+            package does for most games (its `disable_delay`); off means real 60 Hz timers.
+        max_episode_steps: default truncation (env steps of `frames_per_step` frames).
+        category: the paper's category (see `CATEGORIES`).
+        description: one paragraph: goal, keys, reward, termination.
+        version: bumped when behaviour changes (the Gymnasium id's -vN).
+    """
+
+    id: str
+    title: str
+    rom_file: str
+    rom_sha1: str
+    action_keys: tuple[int, ...]
+    score_fn: StateFn
+    terminated_fn: StateFn
+    category: str
+    description: str
+    lives_fn: Optional[StateFn] = None
+    startup: tuple[tuple[int, int], ...] = ()
+    quirks: Union[str, Quirks] = "chip8"
+    freeze_timers: bool = False
+    max_episode_steps: int = 5000
+    version: int = 0
+
+    def __post_init__(self):
+        if not self.action_keys or any(not 0 <= k <= 15 for k in self.action_keys):
+            raise ValueError(f"{self.id}: action_keys must be CHIP-8 keys 0..15, got {self.action_keys}")
+        if len(set(self.action_keys)) != len(self.action_keys):
+            raise ValueError(f"{self.id}: action_keys repeat a key: {self.action_keys}")
+        if self.category not in CATEGORIES:
+            raise ValueError(f"{self.id}: unknown category {self.category!r}; valid: {', '.join(CATEGORIES)}")
+        for mask, frames in self.startup:
+            if not (0 <= mask <= 0xFFFF and frames >= 0):
+                raise ValueError(f"{self.id}: startup steps are (key mask 0..0xFFFF, frames >= 0), got {(mask, frames)}")
+        if self.max_episode_steps <= 0:
+            raise ValueError(f"{self.id}: max_episode_steps must be positive, got {self.max_episode_steps}")
+
+
+CATEGORIES = (
+    "planning",  # Long-horizon planning & spatial reasoning
+    "timing",  # Timing, prediction & reactive control
+    "resources",  # Resource management & tactical decisions
+    "navigation",  # Exploration & continuous navigation
+    "reaction",  # Simple reaction & timing
+)
+
+
+def register_value(state: MachineState, index: int) -> jax.Array:
+    """V[index] as int32, so that score arithmetic cannot wrap around at 256 as uint8 would."""
+    return state.V[index].astype(jnp.int32)
+
+
+def key_mask(*keys: int) -> int:
+    """The 16-bit mask holding `keys`, for `GameSpec.startup`."""
+    mask = 0
+    for key in keys:
+        mask |= 1 << key
+    return mask

@@ -1,0 +1,128 @@
+"""`octax-gym list` and `octax-gym info GAME`: the registered games, read from their specs.
+
+Nothing is emulated: both commands read `GameSpec`s, the `EnvConfig` defaults and the ROM store
+(hashing the small ROM files), so they answer in about the time it takes to import JAX.
+
+    octax-gym list [--category timing]       every game: Gymnasium id, category, actions, ROM
+    octax-gym info Pong                      one game in full (also `info octax/Pong-v0`)
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import textwrap
+
+WIDTH = 100  # `info` wraps its text to this many columns
+
+def add_commands(commands: argparse._SubParsersAction) -> None:
+    """Adds `list` and `info` to the `octax-gym` parser."""
+    games = commands.add_parser("list", help="every game: Gymnasium id, category, actions, ROM status",
+                                description="A table of every registered game and whether its ROM is "
+                                            "present and verified.")
+    games.add_argument("--category", help="only this category (planning, timing, resources, "
+                                          "navigation, reaction)")
+    games.set_defaults(func=_cmd_list)
+    info = commands.add_parser("info", help="one game: actions, spaces, quirks, timers, ROM",
+                               description="Everything a game's spec says, without running it.")
+    info.add_argument("game", help='a game id ("Pong") or Gymnasium id ("octax/Pong-v0")')
+    info.set_defaults(func=_cmd_info)
+
+
+def _cmd_list(args: argparse.Namespace) -> int:
+    from octax_core.env import romstore
+    from octax_core.env.games import CATEGORIES
+    from octax_gym.cli.common import game_specs, print_table
+    from octax_gym.registration import env_id
+
+    specs = game_specs()
+    if args.category is not None:
+        if args.category.lower() not in CATEGORIES:
+            print(f"octax-gym list: error: unknown category {args.category!r}; valid: {', '.join(CATEGORIES)}",
+                  file=sys.stderr)
+            return 2
+        specs = [spec for spec in specs if spec.category == args.category.lower()]
+    if not specs:
+        print("no games registered" + (f" in category {args.category.lower()}" if args.category else ""))
+        return 0
+    table = [("gymnasium id", "category", "actions (keys)", "rom", "title")]
+    statuses = romstore.rom_status(specs)
+    for spec, status in zip(specs, statuses):
+        table.append((env_id(spec.id), spec.category, f"{len(spec.action_keys) + 1} ({_keys(spec.action_keys)})",
+                      _rom_word(status), spec.title))
+    print_table(table)
+    n_ok = sum(status.verified for status in statuses)
+    print(f"\n{len(specs)} games, {n_ok} ROMs present and verified. Actions: 0 = no key, "
+          "then the CHIP-8 keys (hex) in order; `octax-gym info GAME` for one game.")
+    if n_ok < len(specs):
+        print(f"To get the missing ROMs: {romstore.FIX_HINT}.")
+    return 0
+
+
+def _cmd_info(args: argparse.Namespace) -> int:
+    from octax_core.env import romstore
+    from octax_core.env.environment import EnvConfig
+    from octax_core.emulator.quirks import resolve_quirks
+    from octax_gym.cli.common import lookup_spec
+    from octax_gym.registration import env_id
+
+    spec = lookup_spec(args.game)
+    if spec is None:
+        from octax_core.env.games import list_games
+
+        games = list_games()
+        print(f"octax-gym info: error: unknown game {args.game!r}; valid ids: {', '.join(games) or 'none'}"
+              + (f" (or their Gymnasium ids, e.g. {env_id(games[0])})" if games else ""), file=sys.stderr)
+        return 1
+    config = EnvConfig(freeze_timers=spec.freeze_timers)  # what gym.make / make_vec use by default
+    quirks = resolve_quirks(spec.quirks)
+    status = romstore.rom_status([spec])[0]
+    frames, steps_per_second = config.frames_per_step, 60 / config.frames_per_step
+    fields = [
+        ("category", spec.category),
+        ("description", spec.description),
+        ("actions", f"Discrete({len(spec.action_keys) + 1}); action i holds its key for the whole step"),
+        *[("", row) for row in _action_rows(spec.action_keys)],
+        ("observation", (f"Box(0, {config.obs_scale}, ({frames}, 32, 64), uint8), the screen after each frame "
+                         f"of the step; a vector env's is (num_envs, {frames}, 32, 64)")),
+        ("step", (f"{frames} frames x {config.instructions_per_frame} instructions "
+                  f"({steps_per_second:g} steps per second of game time)")),
+        ("quirks", f"{spec.quirks if isinstance(spec.quirks, str) else 'custom'}: "
+                   + ", ".join(f"{name}={value}" for name, value in vars(quirks).items())),
+        ("timers", "frozen: delay and sound zeroed after every step (octax's disable_delay)"
+                   if spec.freeze_timers else "real, 60 Hz (one tick a frame)"),
+        ("max_episode_steps", f"{spec.max_episode_steps} (about {spec.max_episode_steps / steps_per_second:,.0f} s)"),
+        ("startup", (", then ".join(_startup_step(mask, n) for mask, n in spec.startup) or "none")
+                    + "; run once at make, every reset starts there"),
+        ("lives", "yes: info['lives'] counts them" if spec.lives_fn is not None else "no: info['lives'] is -1"),
+        ("rom", spec.rom_file),
+        ("rom sha1", spec.rom_sha1),
+        ("rom status", _rom_word(status) + (f" at {status.path}" if status.path else "")),
+    ]
+    lines = [f"{spec.title}  ({env_id(spec.id)}, game id {spec.id!r}, version {spec.version})"]
+    for name, text in fields:
+        lines.append(textwrap.fill(text, WIDTH, initial_indent=f"{name + ':' if name else '':19}",
+                                   subsequent_indent=" " * 19, break_on_hyphens=False))
+    print("\n".join(lines))
+    if not status.verified:
+        print(f"To fix: {romstore.FIX_HINT}.")
+    return 0
+
+
+def _action_rows(action_keys: tuple[int, ...]) -> list[str]:
+    return ["0  no key"] + [f"{i}  CHIP-8 key {key:X}" for i, key in enumerate(action_keys, start=1)]
+
+
+def _startup_step(mask: int, frames: int) -> str:
+    held = [f"{key:X}" for key in range(16) if mask >> key & 1]
+    return f"{frames} frame{'s' if frames != 1 else ''} " + (f"holding key {','.join(held)}" if held else "(no key)")
+
+
+def _keys(action_keys: tuple[int, ...]) -> str:
+    return ",".join(f"{key:X}" for key in action_keys)
+
+
+def _rom_word(status) -> str:
+    if status.verified:
+        return "verified"
+    return "missing" if status.path is None else "BAD SHA-1"

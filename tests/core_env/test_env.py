@@ -1,0 +1,179 @@
+"""The functional env API on the Counter test game (tests/counter_game.py), so every number below
+is worked by hand: holding key 1 for a 4-frame step scores 4, the game is over when V0 >= 24.
+"""
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+import pytest
+
+import octax_core
+from octax_core.env.testing import check_env
+
+from counter_game import COUNTER, COUNTER_ROM, GOAL
+
+
+@pytest.fixture(scope="module")
+def rom_path(tmp_path_factory):
+    path = tmp_path_factory.mktemp("roms") / "counter.ch8"
+    path.write_bytes(COUNTER_ROM)
+    return path
+
+
+@pytest.fixture(scope="module")
+def counter(rom_path):
+    """make() plus jitted single-env reset/step, built once for the module."""
+    def build(**overrides):
+        env, params = octax_core.make(COUNTER, rom=rom_path, **overrides)
+        return env, params, jax.jit(env.reset), jax.jit(env.step)
+    return build
+
+
+def _play(step, state, params, actions):
+    rows = []
+    for t, action in enumerate(actions):
+        obs, state, reward, terminated, truncated, info = step(jax.random.key(t), state, action, params)
+        rows.append((float(reward), bool(terminated), bool(truncated), int(info["episode_step"]), float(info["score"])))
+    return rows, state, obs, info
+
+
+def test_contract_suite_passes(rom_path):
+    check_env(COUNTER, rom=rom_path, obs_scale=255, autoreset=True, frames_per_step=2)
+
+
+def test_contract_suite_catches_a_broken_game(rom_path):
+    import dataclasses
+    broken = dataclasses.replace(COUNTER, score_fn=lambda s: s.V[0] / 0.0)  # inf / nan rewards
+    with pytest.raises(AssertionError, match="non-finite rewards"):
+        check_env(broken, rom=rom_path)
+
+
+def test_reward_and_termination_table(counter):
+    env, params, reset, step = counter()
+    assert env.num_actions == 3 and env.observation_shape == (4, 32, 64)
+    obs, state = reset(jax.random.key(0), params)
+    rows, state, obs, info = _play(step, state, params, [1, 1, 2, 0, 1, 1, 1])
+    # (reward, terminated, truncated, episode_step, score): key 1 = +4 a step, key 2 = +8.
+    assert rows == [
+        (4.0, False, False, 1, 4.0),
+        (4.0, False, False, 2, 8.0),
+        (8.0, False, False, 3, 16.0),
+        (0.0, False, False, 4, 16.0),
+        (4.0, False, False, 5, 20.0),
+        (4.0, True, False, 6, 24.0),
+        (0.0, True, False, 6, 24.0),  # an ended episode stands still
+    ]
+    assert int(info["lives"]) == 0
+
+
+def test_ended_episode_keeps_state_and_observation(counter):
+    env, params, reset, step = counter()
+    _, state = reset(jax.random.key(0), params)
+    _, state, obs, _ = _play(step, state, params, [2, 2, 2])
+    assert bool(state.done)
+    obs_after, state_after, reward, terminated, _, _ = step(jax.random.key(9), state, 1, params)
+    assert float(reward) == 0.0 and bool(terminated)
+    for a, b in zip(jax.tree.leaves(state), jax.tree.leaves(state_after)):
+        np.testing.assert_array_equal(np.asarray(a), np.asarray(b))
+    np.testing.assert_array_equal(np.asarray(obs_after)[0], np.asarray(obs)[-1])
+
+
+def test_truncation(counter):
+    env, params, reset, step = counter(max_episode_steps=3)
+    _, state = reset(jax.random.key(0), params)
+    rows, *_ = _play(step, state, params, [0, 0, 0, 0])
+    assert [(r[1], r[2]) for r in rows] == [(False, False), (False, False), (False, True), (False, True)]
+
+
+def test_same_step_autoreset(counter):
+    env, params, reset, step = counter(autoreset=True)
+    _, state = reset(jax.random.key(0), params)
+    rows, state, obs, info = _play(step, state, params, [2, 2, 2])
+    assert rows[-1][:2] == (8.0, True)
+    # The returned state and observation start the next episode; the ended one is in info.
+    assert int(state.episode_step) == 0 and float(state.score) == 0.0 and not bool(state.done)
+    assert bool(info["_final"]) and float(info["final_info"]["score"]) == 24.0
+    final = np.asarray(info["final_observation"])
+    lit_rows = np.flatnonzero(final[-1].any(axis=1))
+    assert list(lit_rows) == list(range(GOAL, GOAL + 5))  # the digit drawn at y = V0 = 24
+    assert not np.asarray(obs).any()  # the reset screen is blank (nothing has run yet)
+    rows, *_ = _play(step, state, params, [1])
+    assert rows == [(4.0, False, False, 1, 4.0)]
+
+
+def test_observation_holds_each_frame_and_its_scale(counter):
+    for scale in (1, 255):
+        env, params, reset, step = counter(obs_scale=scale)
+        _, state = reset(jax.random.key(0), params)
+        obs, *_ = step(jax.random.key(1), state, 1, params)
+        obs = np.asarray(obs)
+        assert obs.dtype == np.uint8 and set(np.unique(obs)) == {0, scale}
+        # Frame f shows the digit at y = f + 1 (key 1 adds 1 per frame).
+        tops = [int(np.flatnonzero(frame.any(axis=1))[0]) for frame in obs]
+        assert tops == [1, 2, 3, 4]
+
+
+def test_sticky_actions(counter):
+    env, params, reset, step = counter(repeat_action_probability=1.0)
+    _, state = reset(jax.random.key(0), params)
+    rows, *_ = _play(step, state, params, [1, 2, 1])
+    assert [r[0] for r in rows] == [0.0, 0.0, 0.0]  # the first action (no-op) repeats forever
+    env, params, reset, step = counter(repeat_action_probability=0.0)
+    _, state = reset(jax.random.key(0), params)
+    rows, *_ = _play(step, state, params, [1, 2, 1])
+    assert [r[0] for r in rows] == [4.0, 8.0, 4.0]
+
+
+def test_noop_reset_runs_a_random_number_of_noop_steps(counter):
+    keys = jax.random.split(jax.random.key(3), 16)
+    for noop_max, expect_blank in ((0, True), (30, False)):
+        env, params, _, _ = counter(noop_max=noop_max)
+        obs, state = jax.jit(jax.vmap(env.reset, in_axes=(0, None)))(keys, params)
+        lit = np.asarray(obs).reshape(16, -1).any(axis=1)
+        assert not lit.any() if expect_blank else lit.sum() >= 12  # P(0 no-ops) = 1/31 per env
+        assert np.all(np.asarray(state.episode_step) == 0) and np.all(np.asarray(state.score) == 0)
+
+
+def test_random_state_follows_the_reset_key(counter):
+    env, params, reset, step = counter()
+    positions = set()
+    for seed in range(6):
+        _, state = reset(jax.random.key(seed), params)
+        obs, *_ = step(jax.random.key(0), state, 0, params)
+        positions.add(int(np.flatnonzero(np.asarray(obs)[0].any(axis=0))[0]))
+    assert len(positions) > 1  # the digit's x comes from CXNN, seeded by the reset key
+
+
+def test_bad_actions_are_refused(counter):
+    env, params, reset, step = counter()
+    _, state = reset(jax.random.key(0), params)
+    with pytest.raises(ValueError, match=r"valid actions are 0\.\.2"):
+        env.step(jax.random.key(0), state, 3, params)
+    with pytest.raises(TypeError, match="one integer"):
+        env.step(jax.random.key(0), state, 1.0, params)
+
+
+@pytest.mark.parametrize("overrides, error, message", [
+    ({"frame_skip": 4}, TypeError, "valid: .*frames_per_step"),
+    ({"obs_scale": 2}, ValueError, "obs_scale must be 1 .* or 255"),
+    ({"frames_per_step": 0}, ValueError, "frames_per_step must be a positive int"),
+    ({"repeat_action_probability": 1.5}, ValueError, r"in \[0, 1\]"),
+    ({"noop_max": -1}, ValueError, "noop_max must be an int >= 0"),
+    ({"max_episode_steps": 0}, ValueError, "max_episode_steps must be a positive int"),
+    ({"autoreset": "yes"}, ValueError, "autoreset must be True or False"),
+])
+def test_bad_overrides(rom_path, overrides, error, message):
+    with pytest.raises(error, match=message):
+        octax_core.make(COUNTER, rom=rom_path, **overrides)
+
+
+def test_unknown_game_lists_the_valid_ids():
+    with pytest.raises(KeyError, match="unknown game 'NoSuchGame'; valid ids"):
+        octax_core.make("NoSuchGame")
+
+
+def test_a_rom_with_another_hash_is_refused(tmp_path):
+    wrong = tmp_path / "counter.ch8"
+    wrong.write_bytes(COUNTER_ROM + b"\x00")
+    with pytest.raises(ValueError, match=COUNTER.rom_sha1):
+        octax_core.make(COUNTER, rom=wrong)

@@ -1,0 +1,67 @@
+"""Every registered game: the registry holds the issue's ids and our own games', each passes the
+env contract suite, and each level family member survives random play (the per-group files and
+test_own_games.py cover the rest)."""
+
+import jax
+import numpy as np
+import pytest
+
+import octax_core
+from octax_core.env.testing import check_env
+
+PAPER_IDS = (
+    ["Airplane", "Blinky", "Brix", "Deep8", "Filter", "FlightRunner", "Missile", "Pong", "Rocket",
+     "ShootingStars", "Spacejam", "Squash", "Submarine", "Tank", "Tetris", "UFO", "VerticalBrix",
+     "WipeOff", "Worm"]
+    + [f"Cavern{i}" for i in range(1, 8)]
+    + [f"SpaceFlight{i}" for i in range(1, 11)]
+    + [f"TargetShooter{i}" for i in range(1, 4)]
+)
+# Our own games (roms/*.8o), each in three levels plus the plain id (its middle level).
+OWN_IDS = ["Dodge", "Dodge1", "Dodge2", "Dodge3", "Flak", "Flak1", "Flak2", "Flak3"]
+EXPECTED_IDS = sorted(PAPER_IDS + OWN_IDS)
+# test_games_levels.py plays Cavern1, SpaceFlight1 and TargetShooter1 at random; these are the others.
+OTHER_LEVELS = [g for g in EXPECTED_IDS if g.startswith(("Cavern", "SpaceFlight", "TargetShooter"))
+                and g not in ("Cavern1", "SpaceFlight1", "TargetShooter1")]
+
+
+def test_registry_holds_exactly_the_suite():
+    assert octax_core.list_games() == EXPECTED_IDS
+
+
+def test_specs_are_complete():
+    for game_id in EXPECTED_IDS:
+        spec = octax_core.get_spec(game_id)
+        assert spec.id == game_id and spec.description and spec.title
+        assert len(spec.rom_sha1) == 40 and spec.rom_file.endswith(".ch8")
+        assert spec.quirks in ("chip8", "schip"), f"{game_id}: quirks {spec.quirks!r}"
+
+
+@pytest.mark.parametrize("game_id", EXPECTED_IDS)
+def test_contract(game_id, octax_rom_dir):
+    check_env(game_id, num_envs=2, steps=3)
+
+
+@pytest.mark.parametrize("game_id", OTHER_LEVELS)
+def test_random_policy_gives_finite_rewards(game_id, octax_rom_dir):
+    env, params = octax_core.make(game_id)
+    num_envs, steps = 16, 1500
+    reset = jax.jit(jax.vmap(env.reset, in_axes=(0, None)))
+    step = jax.jit(jax.vmap(env.step, in_axes=(0, 0, 0, None)))
+    _, state = reset(jax.random.split(jax.random.key(0), num_envs), params)
+    actions = np.random.default_rng(0).integers(0, env.num_actions, (steps, num_envs), dtype=np.int32)
+    keys = jax.random.split(jax.random.key(1), (steps, num_envs))
+    total = np.zeros(num_envs)
+    for t in range(steps):
+        _, state, reward, _, _, _ = step(keys[t], state, actions[t], params)
+        total += np.asarray(reward)
+    assert np.all(np.isfinite(total)), f"{game_id}: returns {total}"
+
+
+def test_docs_games_table_is_current():
+    import runpy
+    from pathlib import Path
+
+    docs = Path(__file__).resolve().parents[2] / "docs"
+    table = runpy.run_path(str(docs / "games_table.py"))["games_table"]()
+    assert table in (docs / "games.md").read_text(), "docs/games.md is stale: run python docs/games_table.py"

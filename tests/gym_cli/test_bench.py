@@ -1,0 +1,177 @@
+"""benchmarks/throughput.py and its door `octax-gym bench`: tiny runs, real output.
+
+Each run compiles a rollout, so N and the step counts are as small as they go: these check the
+plumbing and the output format, never a speed.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import jax
+import pytest
+
+from octax_gym import cli
+
+REPO = Path(__file__).resolve().parents[2]
+sys.path.insert(0, str(REPO / "benchmarks"))
+import harness  # noqa: E402  (benchmarks/ is a folder of scripts, not a package)
+import throughput  # noqa: E402
+
+TINY = ["--envs", "2", "--steps", "2", "--repeats", "1"]
+FIELDS = ["mode", "n", "devices", "steps", "sps", "ips", "state_bytes", "compile_s", "octax_sps",
+          "octax_compile_s", "ratio", "device"]
+
+
+def bench_lines(out: str) -> list[dict[str, str]]:
+    """Each `BENCH throughput k=v ...` line of `out` as an ordered dict of strings."""
+    return harness.parse_bench_lines(out, "throughput")
+
+
+def check_line(fields: dict[str, str], mode: str, n: int, steps: int) -> None:
+    assert (fields["mode"], fields["n"], fields["steps"]) == (mode, str(n), str(steps))
+    assert int(fields["sps"]) > 0 and int(fields["ips"]) == pytest.approx(int(fields["sps"]) * 44, rel=0.01)
+    assert int(fields["state_bytes"]) > 4096
+    assert float(fields["compile_s"]) >= 0  # gym: 0.0 when this process already compiled that N
+    assert fields["device"] == jax.default_backend()
+
+
+@pytest.mark.parametrize("mode", ["machine", "env", "gym"])
+def test_cli_bench_prints_one_parseable_line_per_n_and_the_bar_on_stderr(mode, octax_rom_dir, capsys):
+    assert cli.main(["bench", "--quick", "--no-octax", "--mode", mode, *TINY]) == 0
+    out, err = capsys.readouterr()
+    (fields,) = bench_lines(out)  # explicit --envs and --repeats win over --quick
+    check_line(fields, mode, 2, 2)
+    assert list(fields) == FIELDS + (["backend"] if mode == "gym" else [])
+    assert (fields["octax_sps"], fields["octax_compile_s"], fields["ratio"], fields["devices"]) == ("na",) * 3 + ("1",)
+    assert "run 1/1" in err and "BENCH" not in err  # the progress bar, on stderr only
+    assert "run 1/1" not in out
+
+
+@pytest.mark.parametrize("backend", ["jax", "torch"])
+def test_gym_mode_backends(backend, capsys):
+    assert cli.main(["bench", "--no-octax", "--mode", "gym", "--backend", backend, "--no-progress", *TINY]) == 0
+    out, err = capsys.readouterr()
+    (fields,) = bench_lines(out)
+    check_line(fields, "gym", 2, 2)
+    assert fields["backend"] == backend and err == ""
+    assert f"gym-{backend} n=2:" in out
+
+
+def test_octax_comparison_and_jsonl(tmp_path, capsys):
+    jsonl = tmp_path / "bench.jsonl"
+    argv = ["bench", "--mode", "gym", "--envs", "2,3", "--steps", "2", "--repeats", "1", "--octax-max-envs", "2",
+            "--jsonl", str(jsonl), "--no-progress"]
+    assert cli.main(argv) == 0
+    lines = bench_lines(capsys.readouterr().out)
+    assert [line["n"] for line in lines] == ["2", "3"]
+    assert int(lines[0]["octax_sps"]) > 0 and float(lines[0]["ratio"]) > 0  # same work: 44 instructions a step
+    assert lines[1]["octax_sps"] == "na"  # above --octax-max-envs
+    records = [json.loads(line) for line in jsonl.read_text().splitlines()]
+    assert [{k: ("na" if v is None else str(v)) for k, v in r.items()} for r in records] == lines
+
+
+def test_missing_octax_is_a_one_line_note_not_a_crash(monkeypatch, capsys):
+    monkeypatch.setitem(sys.modules, "octax", None)  # `import octax` now raises ImportError
+    assert cli.main(["bench", "--mode", "machine", "--no-progress", *TINY]) == 0
+    out = capsys.readouterr().out
+    notes = [line for line in out.splitlines() if "octax comparison skipped" in line]
+    assert len(notes) == 1 and "pip install 'octax-gym[dev]'" in notes[0]
+    (fields,) = bench_lines(out)
+    assert fields["octax_sps"] == "na" and fields["ratio"] == "na"
+
+
+def _checked(argv: list[str]) -> argparse.Namespace:
+    parser = argparse.ArgumentParser()
+    throughput.add_arguments(parser)
+    return throughput.check_args(parser, parser.parse_args(argv))
+
+
+def test_quick_fills_only_what_is_not_given():
+    assert (_checked(["--quick"]).envs, _checked(["--quick"]).repeats) == ([64, 512], 2)
+    assert (_checked([]).envs, _checked([]).repeats) == ([1, 64, 512, 2048, 8192], 5)
+    quick = _checked(["--quick", "--envs", "8,16", "--repeats", "3"])
+    assert (quick.envs, quick.repeats) == ([8, 16], 3)
+    assert _checked(["--mode", "gym"]).backend == "numpy" and _checked([]).backend is None
+    assert _checked([]).progress is False
+
+
+@pytest.mark.parametrize("argv, message", [
+    (["--mode", "machine", "--backend", "torch"], "--backend applies to --mode gym only"),
+    (["--mode", "gym", "--devices", "2"], "--devices must be 1"),
+    (["--envs", "2,x"], "--envs must be"),
+    (["--envs", "0"], "--envs must be"),
+    (["--steps", "0"], "must be >= 1"),
+    (["--key", "16"], "--key must be in -1..15"),
+    (["--mode", "atari"], "invalid choice"),
+])
+def test_bad_options_are_usage_errors(argv, message, capsys):
+    with pytest.raises(SystemExit) as exc:
+        cli.main(["bench", *argv])
+    assert exc.value.code == 2 and message in capsys.readouterr().err
+
+
+def test_a_key_pong_has_no_action_for_fails_before_compiling(capsys):
+    assert cli.main(["bench", "--mode", "env", "--key", "5", *TINY]) == 1
+    err = capsys.readouterr().err
+    assert "octax-gym bench: error: Pong has no action for key 5 (keys [1, 4])" in err
+
+
+def test_a_missing_rom_is_an_error(tmp_path, capsys):
+    assert cli.main(["bench", "--rom", str(tmp_path / "nothing.ch8"), *TINY]) == 1
+    assert "octax-gym bench: error:" in capsys.readouterr().err
+
+
+def test_devices_after_jax_has_computed_is_a_clear_error(capsys):
+    jax.numpy.zeros(1).block_until_ready()  # this process's device count is now fixed
+    if jax.device_count() == 2:
+        pytest.fail("the test process already has 2 devices; this test needs 1")
+    assert cli.main(["bench", "--devices", "2", "--no-octax", *TINY]) == 1
+    assert "already run a computation" in capsys.readouterr().err
+
+
+def test_cli_devices_splits_the_batch_although_octax_gym_imports_jax():
+    # `python -m octax_gym` imports jax (via the octax_gym package) before parsing --devices.
+    result = subprocess.run(
+        [sys.executable, "-m", "octax_gym", "bench", "--devices", "2", "--envs", "4", "--steps", "2",
+         "--repeats", "1", "--no-octax", "--no-progress"],
+        capture_output=True, text=True, timeout=300, cwd=REPO, check=False)
+    assert result.returncode == 0, result.stderr
+    (fields,) = bench_lines(result.stdout)
+    assert fields["devices"] == "2" and fields["mode"] == "machine"
+    assert "devices=2" in result.stdout.splitlines()[0]
+
+
+def test_thin_script_still_runs_without_a_progress_bar():
+    result = subprocess.run([sys.executable, "benchmarks/throughput.py", "--no-octax", *TINY],
+                            capture_output=True, text=True, timeout=300, cwd=REPO, check=False)
+    assert result.returncode == 0, result.stderr
+    (fields,) = bench_lines(result.stdout)
+    check_line(fields, "machine", 2, 2)
+    assert list(fields) == FIELDS and "run 1/1" not in result.stderr
+    assert result.stdout.startswith("# jax ")
+
+
+def test_thin_script_reports_usage_errors():
+    result = subprocess.run([sys.executable, "benchmarks/throughput.py", "--backend", "torch"],
+                            capture_output=True, text=True, timeout=300, cwd=REPO, check=False)
+    assert result.returncode == 2 and "--backend applies to --mode gym only" in result.stderr
+
+
+def test_the_door_names_what_a_wheel_install_lacks(monkeypatch, tmp_path, capsys):
+    from octax_gym.cli import bench as cli_bench
+
+    monkeypatch.setattr(cli_bench, "BENCHMARKS", tmp_path / "benchmarks")  # as beside an installed wheel
+    assert cli.main(["bench", "--quick"]) == 1
+    err = capsys.readouterr().err
+    assert "benchmarks/throughput.py of a source checkout" in err and "make bench" in err
+
+
+def test_only_bench_takes_arguments_it_does_not_declare(capsys):
+    with pytest.raises(SystemExit) as exc:
+        cli.main(["list", "--envs", "2"])
+    assert exc.value.code == 2 and "unrecognized arguments: --envs 2" in capsys.readouterr().err
