@@ -53,16 +53,20 @@ def action_for_key(env, key: int) -> int:
     return keys.index(key)
 
 
-def prepare(rom: Path, n: int, args: argparse.Namespace, autoreset: bool = False) -> Prepared:
+def prepare(rom: Path, n: int, args: argparse.Namespace, autoreset: bool = False,
+            max_episode_steps: Optional[int] = None) -> Prepared:
     """octax: vmapped `OctaxEnv.step(state, action)`, scanned `args.steps` times (its paper's benchmark).
 
     With `autoreset`, each step also resets the envs whose episode ended, the way gymnax's
     `Environment.step` (octax's training wrapper) does it: a reset for every env, then a select.
+    `max_episode_steps` replaces octax's truncation bound (4500 steps).
     """
     import jax
     import jax.numpy as jnp
 
     env = pong(rom)
+    if max_episode_steps is not None:
+        env.max_num_steps_per_episodes = max_episode_steps
     keys = jax.random.split(jax.random.key(0), n)
     states, obs, _ = jax.vmap(env.reset)(keys)
     actions = jnp.full((n,), action_for_key(env, args.key), dtype=jnp.int32)

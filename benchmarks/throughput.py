@@ -168,13 +168,13 @@ def prepare_env(rom: Path, n: int, args: argparse.Namespace, **overrides) -> Pre
     return Prepared(run, compile_s, state_bytes(states), FRAMES_PER_STEP * INSTRUCTIONS_PER_FRAME, devices)
 
 
-def prepare_gym(rom: Path, n: int, args: argparse.Namespace) -> Prepared:
+def prepare_gym(rom: Path, n: int, args: argparse.Namespace, **overrides) -> Prepared:
     """The Gymnasium vector env: `steps` calls of `envs.step(actions)`, from Python.
 
     Each call checks the actions, runs one jitted step (key split, batched step, autoreset) and
     hands obs, reward, flags and info over as `--backend` arrays, as an RL loop sees them. The
     actions are a fixed array of that backend. Every timed run starts from `reset(seed=0)`
-    (untimed), so all runs do the same work.
+    (untimed), so all runs do the same work. `overrides` are more `make_vec` keywords.
     """
     import time
 
@@ -185,7 +185,7 @@ def prepare_gym(rom: Path, n: int, args: argparse.Namespace) -> Prepared:
     from octax_gym.registration import env_id
 
     envs = gym.make_vec(env_id(GAME), num_envs=n, backend=args.backend, rom=rom,
-                        frames_per_step=FRAMES_PER_STEP, instructions_per_frame=INSTRUCTIONS_PER_FRAME)
+                        frames_per_step=FRAMES_PER_STEP, instructions_per_frame=INSTRUCTIONS_PER_FRAME, **overrides)
     core = envs.unwrapped.core_env
     actions = np.full((n,), our_action(core.spec.action_keys, args.key), np.int32)
     if args.backend != "numpy":  # where a policy's actions would be: on the env's device

@@ -12,10 +12,11 @@ from typing import Any, Optional
 import gymnasium
 import numpy as np
 
-from octax_gym import backends, render
+from octax_core.env.config import check_option_names
+from octax_gym import backends
 from octax_gym.vector import FRAMES_PER_SECOND, KEYWORDS, OctaxVectorEnv
 
-SINGLE_KEYWORDS = tuple(k for k in KEYWORDS if k != "autoreset_mode")
+SINGLE_KEYWORDS = tuple(k for k in KEYWORDS if k != "autoreset_mode")  # a single env never autoresets
 
 
 class OctaxEnv(gymnasium.Env):
@@ -30,10 +31,7 @@ class OctaxEnv(gymnasium.Env):
     metadata = {"render_modes": ["rgb_array"], "render_fps": FRAMES_PER_SECOND // 4}
 
     def __init__(self, game: Any, *, render_mode: Optional[str] = None, **options):
-        unknown = set(options) - set(SINGLE_KEYWORDS)
-        if unknown:
-            raise TypeError(f"OctaxEnv got unknown keyword(s) {sorted(unknown)}; valid: render_mode, "
-                            + ", ".join(SINGLE_KEYWORDS))
+        check_option_names(options, SINGLE_KEYWORDS, type(self).__name__)
         self._vector = OctaxVectorEnv(game, 1, autoreset_mode="disabled", render_mode=render_mode, **options)
         self.render_mode = render_mode
         self.backend = self._vector.backend

@@ -1,15 +1,17 @@
 """The compiled programs behind the Gymnasium envs: one jitted call per reset and per step.
 
-Both envs (`OctaxEnv`, `OctaxVectorEnv`) build on the functional core (`octax_core.make`, with its
-own autoreset off) and differ only in batching and host conversions. The pieces here are shared so
-that a single env and row i of a vector env draw the same random numbers in the same order:
+Both envs (`OctaxEnv`, `OctaxVectorEnv`) run the functional core (`octax_core.make`, its own
+autoreset off) through this, and differ only in batching and host conversions. What is here is
+what Gymnasium adds to the core:
 
 * every env carries its own PRNG key; each step splits it three ways (next key, step key, reset
   key), so one env's randomness never depends on how many envs run beside it;
 * a reset with seed s starts env i's chain at `jax.random.key(s + i)` (Gymnasium's `SyncVectorEnv`
   seeds its sub-envs s, s+1, ...), so row i equals a single env reset with seed s + i;
-* autoreset (Gymnasium's NEXT_STEP or SAME_STEP) runs inside the step, behind one batch-level
-  `lax.cond`: the reset work is paid only on steps where some episode ended.
+* Gymnasium's autoreset modes pick which rows the core's one `Env.autoreset` restarts: NEXT_STEP
+  the rows that had ended before this step, SAME_STEP the rows that end in it, and a masked
+  `reset` the rows asked for;
+* the info dict gets Gymnasium's `_name` masks, and SAME_STEP its batched `final_obs`/`final_info`.
 
 Programs are cached per (game, config, ROM), so every env of one game shares its compilations.
 """
@@ -25,8 +27,11 @@ import numpy as np
 from gymnasium.vector import AutoresetMode
 
 import octax_core
-from octax_core.env.environment import Env, EnvConfig, EnvParams, EnvState
-from octax_core.env.games import GameSpec
+from octax_core.env import ENV_OPTIONS, Env, EnvConfig, EnvParams, EnvState, GameSpec
+
+# What the Gymnasium envs pass to the core: every env option but `autoreset`, which Gymnasium's
+# own `autoreset_mode` replaces.
+GYM_ENV_OPTIONS = tuple(name for name in ENV_OPTIONS if name != "autoreset")
 
 
 def advance(key: jax.Array) -> tuple[jax.Array, jax.Array, jax.Array]:
@@ -35,19 +40,13 @@ def advance(key: jax.Array) -> tuple[jax.Array, jax.Array, jax.Array]:
     return next_key, step_key, reset_key
 
 
-def _select(mask: jax.Array, on_true, on_false):
-    """Row-wise select over pytrees whose leaves have the batch as their first axis."""
-    def pick(a, b):
-        return jnp.where(mask.reshape(mask.shape + (1,) * (a.ndim - 1)), a, b)
-    return jax.tree.map(pick, on_true, on_false)
-
-
 class Program:
     """The jitted reset and step of one game and config, for any batch size."""
 
     def __init__(self, env: Env):
         self.env = env
         self.info = jax.vmap(env.info)
+        self._autoreset = jax.vmap(env.autoreset, in_axes=(0, 0, 0, 0, None))
         self.reset = jax.jit(self._reset)
         self.step = {mode: jax.jit(functools.partial(self._step, mode=mode), donate_argnums=(1,))
                      for mode in AutoresetMode}
@@ -57,11 +56,12 @@ class Program:
     def _reset(self, keys, state: Optional[EnvState], obs, mask, params: EnvParams):
         """Resets the rows in `mask` (all rows when `state` is None); returns keys, obs, state, info."""
         next_keys, _, reset_keys = jax.vmap(advance)(keys)
-        fresh_obs, fresh = jax.vmap(self.env.reset, in_axes=(0, None))(reset_keys, params)
-        if state is not None:
-            fresh_obs, fresh = _select(mask, (fresh_obs, fresh), (obs, state))
+        if state is None:
+            obs, state = jax.vmap(self.env.reset, in_axes=(0, None))(reset_keys, params)
+        else:
+            obs, state = self._autoreset(reset_keys, mask, obs, state, params)
             next_keys = select_keys(mask, next_keys, keys)
-        return next_keys, fresh_obs, fresh, self._with_masks(self.info(fresh))
+        return next_keys, obs, state, self._with_masks(self.info(state))
 
     def _step(self, keys, state: EnvState, actions, params: EnvParams, *, mode: AutoresetMode):
         next_keys, step_keys, reset_keys = jax.vmap(advance)(keys)
@@ -71,23 +71,16 @@ class Program:
         if mode == AutoresetMode.NEXT_STEP:
             # The step after an episode's end is its reset: the action is ignored, and the core
             # already gave the ended (standing-still) row reward 0; its flags are cleared here.
-            obs, state = self._reset_where(was_done, reset_keys, obs, state, params)
+            obs, state = self._autoreset(reset_keys, was_done, obs, state, params)
             terminated, truncated = terminated & ~was_done, truncated & ~was_done
             info = self.info(state)
         elif mode == AutoresetMode.SAME_STEP:
             ended = state.done
             final = {"final_obs": obs, "_final_obs": ended,
                      "final_info": self._with_masks(info), "_final_info": ended}
-            obs, state = self._reset_where(ended, reset_keys, obs, state, params)
+            obs, state = self._autoreset(reset_keys, ended, obs, state, params)
             return next_keys, obs, state, reward, terminated, truncated, {**self._with_masks(self.info(state)), **final}
         return next_keys, obs, state, reward, terminated, truncated, self._with_masks(info)
-
-    def _reset_where(self, mask, reset_keys, obs, state, params):
-        def reset_rows(operands):
-            obs, state = operands
-            fresh = jax.vmap(self.env.reset, in_axes=(0, None))(reset_keys, params)
-            return _select(mask, fresh, (obs, state))
-        return jax.lax.cond(jnp.any(mask), reset_rows, lambda operands: operands, (obs, state))
 
     @staticmethod
     def _with_masks(info: dict) -> dict:
@@ -97,7 +90,8 @@ class Program:
 
 def select_keys(mask, on_true, on_false):
     """Row-wise select between two batches of typed PRNG keys."""
-    data = _select(mask, jax.random.key_data(on_true), jax.random.key_data(on_false))
+    data_true, data_false = jax.random.key_data(on_true), jax.random.key_data(on_false)
+    data = jnp.where(mask.reshape(mask.shape + (1,) * (data_true.ndim - 1)), data_true, data_false)
     return jax.random.wrap_key_data(data, impl=jax.random.key_impl(on_true))
 
 
@@ -106,18 +100,11 @@ def _program(spec: GameSpec, config: EnvConfig, rom: Optional[str]) -> Program:
     return Program(Env(spec, config, rom))
 
 
-CORE_OPTIONS = ("frames_per_step", "instructions_per_frame", "obs_scale", "freeze_timers")
-PARAM_OPTIONS = ("max_episode_steps", "repeat_action_probability", "noop_max")
-
-
 def build(game: Any, rom, options: dict[str, Any]) -> tuple[Program, EnvParams]:
-    """The cached program and checked params for a game id or `GameSpec` and the env options.
-
-    `options` holds the env keywords; None means the game's default.
-    """
+    """The cached program and checked params for a game id or `GameSpec` and `GYM_ENV_OPTIONS`
+    keywords (None means the game's default)."""
     spec = game if isinstance(game, GameSpec) else octax_core.get_spec(_check_game(game))
-    given = {name: value for name, value in options.items() if value is not None}
-    config, params = octax_core.make_config(spec, autoreset=False, **given)  # checks every value
+    config, params = octax_core.make_config(spec, autoreset=False, **options)  # checks every value
     return _program(spec, config, None if rom is None else str(rom)), params
 
 

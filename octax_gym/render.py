@@ -11,6 +11,8 @@ from typing import Sequence, Union
 import cv2
 import numpy as np
 
+from octax_core.validate import check_int
+
 RGB = tuple[int, int, int]
 
 # (off, on) colours. "octo" is the Octo IDE's default pair; the rest are phosphor looks.
@@ -51,16 +53,7 @@ def resolve_palette(palette: PaletteArg) -> np.ndarray:
 
 
 def check_render_scale(scale) -> int:
-    if isinstance(scale, bool) or not isinstance(scale, (int, np.integer)) or not 1 <= scale <= MAX_RENDER_SCALE:
-        raise ValueError(f"render_scale must be an int in 1..{MAX_RENDER_SCALE}, got {scale!r}")
-    return int(scale)
-
-
-def unpack_words(screen: np.ndarray) -> np.ndarray:
-    """Packed screen words (..., 32, 2) uint32 -> (..., 32, 64) bool, on the host."""
-    screen = np.asarray(screen, np.uint32)
-    big_endian = screen.astype(">u4").view(np.uint8)  # each word's top bit is the leftmost pixel
-    return np.unpackbits(big_endian, axis=-1).astype(bool)
+    return check_int("render_scale", scale, 1, MAX_RENDER_SCALE)
 
 
 def to_rgb(pixels: np.ndarray, scale: int, palette: np.ndarray) -> np.ndarray:

@@ -12,6 +12,7 @@ outputs reach numpy, JAX or torch without a copy (`backend=`). See docs/gymnasiu
 
 from __future__ import annotations
 
+import inspect
 from typing import Any, Optional, Union
 
 import gymnasium
@@ -21,7 +22,10 @@ from gymnasium import spaces
 from gymnasium.vector import AutoresetMode
 
 from octax_gym import backends, program, render
-from octax_gym.program import build, keys_from_seeds, seeds_for
+from octax_core.emulator.state import unpack_screen
+from octax_core.env.config import check_option_names
+from octax_core.validate import check_int
+from octax_gym.program import GYM_ENV_OPTIONS, build, keys_from_seeds, seeds_for
 
 FRAMES_PER_SECOND = 60  # the CHIP-8 timer rate; a step lasts frames_per_step of these frames
 
@@ -35,12 +39,6 @@ def check_autoreset_mode(mode) -> AutoresetMode:
     raise ValueError(f"unknown autoreset_mode {mode!r}; valid: "
                      + ", ".join(f"AutoresetMode.{m.name}" for m in AutoresetMode)
                      + " (or the strings 'next_step', 'same_step', 'disabled')")
-
-
-def check_num_envs(num_envs) -> int:
-    if isinstance(num_envs, bool) or not isinstance(num_envs, (int, np.integer)) or num_envs < 1:
-        raise ValueError(f"num_envs must be a positive int, got {num_envs!r}")
-    return int(num_envs)
 
 
 class OctaxVectorEnv(gymnasium.vector.VectorEnv):
@@ -68,13 +66,13 @@ class OctaxVectorEnv(gymnasium.vector.VectorEnv):
         device: where the env runs and its arrays live: None (JAX's default), "cpu", "cuda",
             "cuda:1", a jax.Device or a torch.device.
         render_mode: None or "rgb_array" (`render()` returns a tuple of num_envs frames).
-        frames_per_step, instructions_per_frame, obs_scale, freeze_timers: fixed at
-            construction (None = the game's default; see `octax_core.EnvConfig`).
-        max_episode_steps, repeat_action_probability, noop_max: the episode params (None = the
-            game's default; see `octax_core.EnvParams`).
         render_scale: pixel size of a rendered frame (default 8: 512 x 256).
         palette: a name from `octax_gym.render.PALETTES` or an (off, on) pair of RGB triples.
         rom: an explicit ROM path (its SHA-1 must match the game's).
+        **env_options: the core env's options (`octax_core.env.config`; None or absent = the
+            game's default), all but `autoreset`: frames_per_step, instructions_per_frame,
+            obs_scale, freeze_timers and noop_max, fixed at construction (`EnvConfig`), and
+            max_episode_steps and repeat_action_probability (`EnvParams`).
     """
 
     metadata = {"render_modes": ["rgb_array"], "autoreset_mode": AutoresetMode.NEXT_STEP,
@@ -83,14 +81,10 @@ class OctaxVectorEnv(gymnasium.vector.VectorEnv):
     def __init__(self, game: Any, num_envs: int = 1, *,
                  autoreset_mode: Union[AutoresetMode, str] = AutoresetMode.NEXT_STEP,
                  backend: str = "numpy", device: Any = None, render_mode: Optional[str] = None,
-                 frames_per_step: Optional[int] = None, instructions_per_frame: Optional[int] = None,
-                 obs_scale: Optional[int] = None, freeze_timers: Optional[bool] = None,
-                 max_episode_steps: Optional[int] = None, repeat_action_probability: Optional[float] = None,
-                 noop_max: Optional[int] = None, render_scale: int = render.DEFAULT_RENDER_SCALE,
-                 palette: render.PaletteArg = render.DEFAULT_PALETTE, rom=None, **unknown):
-        if unknown:
-            raise TypeError(f"OctaxVectorEnv got unknown keyword(s) {sorted(unknown)}; valid: {', '.join(KEYWORDS)}")
-        self.num_envs = check_num_envs(num_envs)
+                 render_scale: int = render.DEFAULT_RENDER_SCALE, palette: render.PaletteArg = render.DEFAULT_PALETTE,
+                 rom=None, **env_options):
+        check_option_names(env_options, KEYWORDS, type(self).__name__)
+        self.num_envs = check_int("num_envs", num_envs)
         self.autoreset_mode = check_autoreset_mode(autoreset_mode)
         self.backend = backends.check_backend(backend)
         self.device = backends.resolve_device(device)
@@ -99,10 +93,7 @@ class OctaxVectorEnv(gymnasium.vector.VectorEnv):
         self.render_mode = render_mode
         self.render_scale = render.check_render_scale(render_scale)
         self.palette = render.resolve_palette(palette)
-        self._program, params = build(game, rom, dict(
-            frames_per_step=frames_per_step, instructions_per_frame=instructions_per_frame,
-            obs_scale=obs_scale, freeze_timers=freeze_timers, max_episode_steps=max_episode_steps,
-            repeat_action_probability=repeat_action_probability, noop_max=noop_max))
+        self._program, params = build(game, rom, env_options)
         self.core_env = self._program.env
         self.game_spec = self.core_env.spec
         self.params = jax.device_put(params, self.device)
@@ -163,7 +154,7 @@ class OctaxVectorEnv(gymnasium.vector.VectorEnv):
             return None
         if self._state is None:
             raise gymnasium.error.ResetNeeded("call reset() before render()")
-        pixels = render.unpack_words(np.asarray(self._state.machine.screen))
+        pixels = unpack_screen(np.asarray(self._state.machine.screen))
         return tuple(render.to_rgb(p, self.render_scale, self.palette) for p in pixels)
 
     def close_extras(self, **kwargs):
@@ -194,6 +185,7 @@ class OctaxVectorEnv(gymnasium.vector.VectorEnv):
         return f"OctaxVectorEnv({self.game_spec.id}, num_envs={self.num_envs}, backend={self.backend!r})"
 
 
-KEYWORDS = ("autoreset_mode", "backend", "device", "render_mode", "frames_per_step", "instructions_per_frame",
-            "obs_scale", "freeze_timers", "max_episode_steps", "repeat_action_probability", "noop_max",
-            "render_scale", "palette", "rom")
+# Every keyword the vector env takes: its own (the keyword-only arguments above) and the core's
+# env options (`octax_core.env.config`, autoreset aside: `autoreset_mode` replaces it).
+KEYWORDS = tuple(name for name, parameter in inspect.signature(OctaxVectorEnv.__init__).parameters.items()
+                 if parameter.kind == inspect.Parameter.KEYWORD_ONLY) + GYM_ENV_OPTIONS

@@ -13,12 +13,14 @@ import operator
 from typing import Union
 
 import jax
+import jax.numpy as jnp
 
 from octax_core.emulator import cpu
 from octax_core.emulator.keypad import keys_to_mask
 from octax_core.emulator.quirks import Quirks, resolve_quirks
 from octax_core.emulator.rom import Rom, RomLike
 from octax_core.emulator.state import MachineState, boot_state
+from octax_core.validate import check_int
 
 
 @dataclasses.dataclass(frozen=True)
@@ -44,9 +46,8 @@ class Machine:
 
     def __post_init__(self):
         object.__setattr__(self, "quirks", resolve_quirks(self.quirks))
-        ipf = self.instructions_per_frame
-        if isinstance(ipf, bool) or not isinstance(ipf, int) or ipf <= 0:
-            raise ValueError(f"instructions_per_frame must be a positive int, got {ipf!r}")
+        object.__setattr__(self, "instructions_per_frame",
+                           check_int("instructions_per_frame", self.instructions_per_frame))
 
     def boot(self, rom: RomLike, key: jax.Array) -> MachineState:
         """A powered-on machine with `rom` loaded at 0x200; the key seeds CXNN.
@@ -60,26 +61,50 @@ class Machine:
         new_state, _ = cpu.execute(self.quirks, state, keys_to_mask(keys))
         return new_state
 
-    def run_frames(self, state: MachineState, keys, frames: int) -> MachineState:
-        """Runs `frames` 60 Hz frames with `keys` held throughout.
+    def run_frames(self, state: MachineState, keys, frames, *, halted=None, record_screens: bool = False):
+        """Runs `frames` 60 Hz frames with `keys` held throughout: the one frame loop.
 
         Args:
             state: one machine (vmap for a batch).
             keys: bool[16] or an integer mask, bit k = key k.
-            frames: how many frames; a Python int (static under jit).
+            frames: how many frames. A Python int fixes the loop length at trace time (mark it
+                static under jit); an integer scalar array may be traced, so one compile serves
+                every count (not with `record_screens`, whose output has `frames` rows).
+            halted: optional bool scalar; where true nothing runs, the timers do not tick and
+                the state comes back unchanged (the env halts episodes that have ended).
+            record_screens: also return the packed screen after each frame.
+
+        Returns:
+            The state after the frames; with `record_screens`, `(state, screens)` where screens
+            is (frames, 32, 2) uint32 (`octax_core.emulator.state.unpack_screen` unpacks it).
+
+        Raises:
+            TypeError: `frames` is neither an int nor an integer scalar array, or is an array
+                while `record_screens` is set.
+            ValueError: a negative frame count given as an int.
         """
+        mask = keys_to_mask(keys)
+
+        def frame(state):
+            return cpu.run_frame(self.quirks, self.instructions_per_frame, state, mask, halted)
+
+        if isinstance(frames, jax.Array) and not record_screens:
+            if frames.shape != () or not jnp.issubdtype(frames.dtype, jnp.integer):
+                raise TypeError(f"frames must be an int or an integer scalar array, got {frames.dtype} {frames.shape}")
+            return jax.lax.fori_loop(0, frames, lambda _, state: frame(state), state)
         try:
             frames = operator.index(frames)
         except TypeError:
             raise TypeError(
-                f"frames must be a Python int (mark it static under jit), got {type(frames).__name__}"
+                f"frames must be a Python int (mark it static under jit){'' if record_screens else ' or an integer scalar array'}, "
+                f"got {type(frames).__name__}"
             ) from None
         if frames < 0:
             raise ValueError(f"frames must be >= 0, got {frames}")
-        mask = keys_to_mask(keys)
 
-        def frame(state, _):
-            return cpu.run_frame(self.quirks, self.instructions_per_frame, state, mask), None
+        def body(state, _):
+            state = frame(state)
+            return state, (state.screen if record_screens else None)
 
-        state, _ = jax.lax.scan(frame, state, None, length=frames)
-        return state
+        state, screens = jax.lax.scan(body, state, None, length=frames)
+        return (state, screens) if record_screens else state

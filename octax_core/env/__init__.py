@@ -1,13 +1,15 @@
 """The env API: CHIP-8 games as functional, batched RL environments (Gymnax-style).
 
 `games/` is the registry (one `GameSpec` per game), `romstore` finds and verifies each game's
-ROM, `environment` is the env (`make`, `Env.reset`/`step`), and `testing` the contract suite
+ROM, `config` declares the options, `starts` makes the start states (start-up and no-op starts)
+once per env, `environment` is the env (`make`, `Env.reset`/`step`/`autoreset`), and `testing` the contract suite
 every game passes. Built on `octax_core.emulator`; nothing here imports Gymnasium or torch.
 See docs/env.md.
 """
 
-from octax_core.env.environment import Env, EnvConfig, EnvParams, EnvState, make, make_config, make_params
+from octax_core.env.config import ENV_OPTIONS, EnvConfig, EnvParams, make_config, make_params
+from octax_core.env.environment import Env, EnvState, make
 from octax_core.env.games import GameSpec, get_spec, list_games
 
-__all__ = ["Env", "EnvConfig", "EnvParams", "EnvState", "GameSpec", "get_spec", "list_games", "make",
+__all__ = ["ENV_OPTIONS", "Env", "EnvConfig", "EnvParams", "EnvState", "GameSpec", "get_spec", "list_games", "make",
            "make_config", "make_params"]

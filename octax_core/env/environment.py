@@ -1,60 +1,37 @@
-"""The functional, batched env API (Gymnax-style) over a `GameSpec`.
+"""The functional env API (Gymnax-style) over a `GameSpec`: one reset, one step, one autoreset.
 
     env, params = octax_core.make("Pong")
     obs, state = env.reset(key, params)
     obs, state, reward, terminated, truncated, info = env.step(key, state, action, params)
 
-Both functions are for one env; batch them with `jax.vmap` (params broadcast: `in_axes=(0, 0, 0,
-None)`), and use them inside `jit` and `lax.scan`. Config that changes the traced program (frames
-per step, observation scale, timers, autoreset) is fixed at `make`; `EnvParams` holds what may
-change without recompiling. The ROM is booted and its start-up run once, at `make`: a reset
-copies that template and swaps in a fresh random state.
+Two layers, as in gymnax: `reset_env` and `step_env` are the pure game (an ended episode stands
+still), and `reset` / `step` add what a training loop needs, the same-step autoreset when the
+env is made with `autoreset=True`. `autoreset` is the one reset-where-ended every layer uses:
+`step` here, the Gymnasium vector env's NEXT_STEP and SAME_STEP modes and its masked reset,
+and the register tracer. Everything is for one env; batch with `jax.vmap` (params broadcast:
+`in_axes=(0, 0, 0, None)`) and use inside `jit` and `lax.scan`.
+
+Options that change the traced program are fixed at `make` (`EnvConfig`); `EnvParams` holds what
+may change without recompiling (see `octax_core.env.config`). The ROM is booted, its start-up run
+and the no-op starts made once, at `make` (`octax_core.env.starts`): a reset draws a start state
+and gives it a fresh random seed, at the same small cost whatever `noop_max` is.
 """
 
 from __future__ import annotations
 
 import dataclasses
 import functools
-from typing import Any, Optional, Union
+from typing import Any, Union
 
 import jax
 import jax.numpy as jnp
 import numpy as np
 
-from octax_core.emulator import cpu
-from octax_core.env.games import GameSpec, get_spec
-from octax_core.emulator.keypad import keys_to_mask
 from octax_core.emulator.machine import Machine
-from octax_core.emulator.state import MachineState, seed_rng, unpack_screen
-
-
-@dataclasses.dataclass(frozen=True)
-class EnvConfig:
-    """What `make` fixes for the compiled program.
-
-    Attributes:
-        frames_per_step: 60 Hz frames per env step; the observation holds each of them.
-        instructions_per_frame: CHIP-8 instructions per frame.
-        obs_scale: lit pixels read 1 (default) or 255.
-        freeze_timers: zero both timers after each step (the octax package's `disable_delay`).
-        autoreset: reset inside `step` when an episode ends (same-step), for scan loops.
-    """
-
-    frames_per_step: int = 4
-    instructions_per_frame: int = 11
-    obs_scale: int = 1
-    freeze_timers: bool = False
-    autoreset: bool = False
-
-
-@jax.tree_util.register_dataclass
-@dataclasses.dataclass(frozen=True)
-class EnvParams:
-    """Tunables that may change between calls without recompiling (or be vmapped)."""
-
-    max_episode_steps: jax.Array  # () int32, truncation bound in env steps
-    repeat_action_probability: jax.Array  # () float32, sticky actions (Machado et al., 2018)
-    noop_max: jax.Array  # () int32, reset runs 0..noop_max no-op steps
+from octax_core.emulator.state import MachineState, unpack_screen
+from octax_core.env import starts
+from octax_core.env.config import EnvConfig, EnvParams, make_config, make_params
+from octax_core.env.games import GameSpec, get_spec
 
 
 @jax.tree_util.register_dataclass
@@ -80,7 +57,7 @@ class Env:
     action i holds `spec.action_keys[i - 1]` for the whole step. Reward: change of the game's
     score over the step, float32. Termination: the spec's `terminated_fn`; truncation after
     `params.max_episode_steps` steps. `info`: score, lives (-1 where the game keeps none),
-    episode_step, and with autoreset the final observation of an episode that just ended.
+    episode_step, and with autoreset the final observation and info of an episode that just ended.
     """
 
     def __init__(self, spec: GameSpec, config: EnvConfig, rom_path=None):
@@ -88,8 +65,9 @@ class Env:
 
         self.spec, self.config = spec, config
         self.machine = Machine(quirks=spec.quirks, instructions_per_frame=config.instructions_per_frame)
-        rom = load_game_rom(spec, rom_path)
-        self._template = _run_startup(self.machine, rom, spec.startup)
+        template = starts.boot(self.machine, load_game_rom(spec, rom_path), spec.startup)
+        noop_step = _noop_stepper(self.machine, config.frames_per_step, config.freeze_timers)
+        self._starts = starts.noop_pool(template, noop_step, config.noop_max)
         self._action_masks = np.array([0] + [1 << k for k in spec.action_keys], np.uint32)
 
     @property
@@ -104,57 +82,72 @@ class Env:
     def default_params(self) -> EnvParams:
         return make_params(self.spec)
 
-    def reset(self, key: jax.Array, params: EnvParams) -> tuple[jax.Array, EnvState]:
-        """A new episode from the start-up template; `key` seeds CXNN and the no-op count."""
-        rng_key, noop_key = jax.random.split(key)
-        template = jax.tree.map(jnp.asarray, self._template)
-        machine = template.replace(rng=seed_rng(rng_key))
-        noops = jax.random.randint(noop_key, (), 0, params.noop_max + 1)
-        run_step = functools.partial(self._run_step, keys=jnp.uint32(0))
-        machine = jax.lax.fori_loop(0, noops, lambda _, m: run_step(m)[0], machine)
-        state = EnvState(
-            machine=machine,
-            score=self._score(machine),
-            episode_step=jnp.int32(0),
-            last_action=jnp.int32(0),
-            done=jnp.bool_(False),
-        )
-        obs = jnp.broadcast_to(self._pixels(machine.screen[None]), self.observation_shape)
+    # --- the pure game ------------------------------------------------------------------------
+
+    def reset_env(self, key: jax.Array, params: EnvParams) -> tuple[jax.Array, EnvState]:
+        """A new episode: a start state drawn with `key`, which also seeds CXNN.
+
+        The observation repeats the start screen in every frame.
+        """
+        machine = starts.draw(self._starts, key)
+        state = EnvState(machine=machine, score=self._score(machine), episode_step=jnp.int32(0),
+                         last_action=jnp.int32(0), done=jnp.bool_(False))
+        obs = jnp.broadcast_to(self._observe(machine.screen[None]), self.observation_shape)
         return obs, state
 
-    def step(self, key: jax.Array, state: EnvState, action, params: EnvParams):
-        """Holds the action's key for `frames_per_step` frames.
+    def step_env(self, key: jax.Array, state: EnvState, action, params: EnvParams):
+        """Holds the action's key for `frames_per_step` frames; `key` draws the sticky action.
 
         Returns:
-            obs, state, reward, terminated, truncated, info. Once an episode has ended (without
-            autoreset), further steps return the same state, zero reward and the same flags.
+            obs, state, reward, terminated, truncated, info. Once an episode has ended, further
+            steps return the same state, zero reward and the same flags.
         """
-        sticky_key, reset_key = jax.random.split(key)
         action = self._check_action(action)
-        repeat = jax.random.uniform(sticky_key) < params.repeat_action_probability
+        repeat = jax.random.uniform(key) < params.repeat_action_probability
         action = jnp.where(repeat, state.last_action, action)
         # pgx's rule: an ended episode stands still until it is reset. The machine is halted
         # rather than stepped and then discarded, so its 4 KB of memory is never selected over,
         # and the frames it returns are its last screen.
-        machine, screens = self._run_step(state.machine, jnp.asarray(self._action_masks)[action],
-                                          halted=state.done)
+        machine, screens = _play(self.machine, self.config.frames_per_step, self.config.freeze_timers,
+                                 state.machine, jnp.asarray(self._action_masks)[action], halted=state.done)
         score = self._score(machine)
         terminated = jnp.asarray(self.spec.terminated_fn(machine), jnp.bool_)
         episode_step = jnp.where(state.done, state.episode_step, state.episode_step + 1)
         truncated = ~terminated & (episode_step >= params.max_episode_steps)
         reward = jnp.where(state.done, 0.0, score - state.score).astype(jnp.float32)
-        new_state = EnvState(
-            machine=machine,
-            score=score,
-            episode_step=episode_step,
-            last_action=jnp.where(state.done, state.last_action, action),
-            done=terminated | truncated,
-        )
-        obs = self._pixels(screens)
-        info = self.info(new_state)
+        new_state = EnvState(machine=machine, score=score, episode_step=episode_step,
+                             last_action=jnp.where(state.done, state.last_action, action),
+                             done=terminated | truncated)
+        return self._observe(screens), new_state, reward, terminated, truncated, self.info(new_state)
+
+    # --- what a training loop adds ------------------------------------------------------------
+
+    def reset(self, key: jax.Array, params: EnvParams) -> tuple[jax.Array, EnvState]:
+        """A new episode (`reset_env`)."""
+        return self.reset_env(key, params)
+
+    def step(self, key: jax.Array, state: EnvState, action, params: EnvParams):
+        """`step_env`, then, with `config.autoreset`, a new episode where this one ended.
+
+        With autoreset, an ending step returns the new episode's first observation and state;
+        `info` keeps the ended episode's score, lives and episode_step, and adds
+        `final_observation`, `final_info` and `_final` (true on that step).
+        """
+        step_key, reset_key = jax.random.split(key)
+        obs, state, reward, terminated, truncated, info = self.step_env(step_key, state, action, params)
         if self.config.autoreset:
-            obs, new_state, info = self._autoreset(reset_key, obs, new_state, info, params)
-        return obs, new_state, reward, terminated, truncated, info
+            info = {**info, "final_observation": obs, "final_info": dict(info), "_final": state.done}
+            obs, state = self.autoreset(reset_key, state.done, obs, state, params)
+        return obs, state, reward, terminated, truncated, info
+
+    def autoreset(self, key: jax.Array, mask, obs: jax.Array, state: EnvState, params: EnvParams):
+        """Where `mask` (bool scalar) holds, a new episode (`reset_env(key)`); else `obs`, `state`.
+
+        Both are computed and one is selected (under `vmap` there is no real branching), which
+        costs a draw from the start pool and a select whatever `noop_max` is.
+        """
+        fresh = self.reset_env(key, params)
+        return jax.tree.map(lambda new, old: jnp.where(mask, new, old), fresh, (obs, state))
 
     def info(self, state: EnvState) -> dict[str, jax.Array]:
         """The per-step info of one env: score, lives (-1 where the game keeps none), episode_step."""
@@ -162,20 +155,7 @@ class Env:
 
     # --- pieces -------------------------------------------------------------------------------
 
-    def _run_step(self, machine: MachineState, keys, halted=None) -> tuple[MachineState, jax.Array]:
-        """frames_per_step frames with `keys` held; returns the packed screen after each."""
-        def frame(machine, _):
-            machine = cpu.run_frame(self.machine.quirks, self.config.instructions_per_frame, machine,
-                                    keys, halted)
-            return machine, machine.screen
-
-        machine, screens = jax.lax.scan(frame, machine, None, length=self.config.frames_per_step)
-        if self.config.freeze_timers:
-            machine = machine.replace(delay_timer=jnp.zeros_like(machine.delay_timer),
-                                      sound_timer=jnp.zeros_like(machine.sound_timer))
-        return machine, screens
-
-    def _pixels(self, screens) -> jax.Array:
+    def _observe(self, screens) -> jax.Array:
         return unpack_screen(screens, on=self.config.obs_scale, dtype=jnp.uint8)
 
     def _score(self, machine: MachineState) -> jax.Array:
@@ -186,13 +166,6 @@ class Env:
             return jnp.int32(-1)
         return jnp.asarray(self.spec.lives_fn(machine), jnp.int32)
 
-    def _autoreset(self, key, obs, state: EnvState, info: dict, params: EnvParams):
-        reset_obs, reset_state = self.reset(key, params)
-        ended = state.done
-        info = {**info, "final_observation": obs, "final_info": dict(info), "_final": ended}
-        state = jax.tree.map(lambda fresh, old: jnp.where(ended, fresh, old), reset_state, state)
-        return jnp.where(ended, reset_obs, obs), state, info
-
     def _check_action(self, action) -> jax.Array:
         if not isinstance(action, jax.core.Tracer):
             value = np.asarray(action)
@@ -201,97 +174,45 @@ class Env:
             if not 0 <= int(value) < self.num_actions:
                 raise ValueError(f"{self.spec.id}: action {int(value)} is out of range; valid actions are "
                                  f"0..{self.num_actions - 1} (0 = no-op, keys {list(self.spec.action_keys)})")
-        # Traced actions cannot be checked here: out-of-range values hold no key (documented);
-        # octax_gym checks every action on the host before it reaches the device.
+        # A traced action cannot be checked here: out-of-range values hold no key (documented).
+        # octax_gym checks every action before or inside its jitted step and raises.
         action = jnp.asarray(action, jnp.int32)
         return jnp.where((action >= 0) & (action < self.num_actions), action, 0)
 
 
+def _play(machine: Machine, frames_per_step: int, freeze_timers: bool, state: MachineState, keys, halted=None):
+    """The machine's part of an env step: the frames, recorded, then the timers frozen if asked."""
+    state, screens = machine.run_frames(state, keys, frames_per_step, halted=halted, record_screens=True)
+    if freeze_timers:
+        state = state.replace(delay_timer=jnp.zeros_like(state.delay_timer),
+                              sound_timer=jnp.zeros_like(state.sound_timer))
+    return state, screens
+
 
 @functools.lru_cache(maxsize=None)
-def _frames_runner(machine: Machine):
-    """Runs a traced number of frames with a held key mask; compiled once per machine."""
-    def run(state, keys, frames):
-        frame = lambda _, s: cpu.run_frame(machine.quirks, machine.instructions_per_frame, s, keys)
-        return jax.lax.fori_loop(0, frames, frame, state)
-    return jax.jit(run)
+def _noop_stepper(machine: Machine, frames_per_step: int, freeze_timers: bool):
+    """One no-op env step for a batch of machines, jitted once per (machine, step) config."""
+    return jax.jit(jax.vmap(lambda state: _play(machine, frames_per_step, freeze_timers, state, 0)[0]))
 
 
-def _run_startup(machine: Machine, rom, startup) -> MachineState:
-    """Boots `rom` and runs the start-up (key mask, frames) steps; host numpy arrays out."""
-    state = machine.boot(rom, jax.random.key(0))
-    run = _frames_runner(machine)
-    for mask, frames in startup:
-        state = run(state, keys_to_mask(mask), frames)
-    return jax.tree.map(np.asarray, state)
-
-
-def make_params(spec: GameSpec, max_episode_steps: Optional[int] = None,
-                repeat_action_probability: float = 0.0, noop_max: int = 0) -> EnvParams:
-    """`EnvParams` with checked values; the spec gives the default episode bound."""
-    steps = spec.max_episode_steps if max_episode_steps is None else max_episode_steps
-    if isinstance(steps, bool) or not isinstance(steps, int) or steps <= 0:
-        raise ValueError(f"max_episode_steps must be a positive int, got {steps!r}")
-    if not 0.0 <= float(repeat_action_probability) <= 1.0:
-        raise ValueError(f"repeat_action_probability must be in [0, 1], got {repeat_action_probability!r}")
-    if isinstance(noop_max, bool) or not isinstance(noop_max, int) or noop_max < 0:
-        raise ValueError(f"noop_max must be an int >= 0, got {noop_max!r}")
-    return EnvParams(jnp.int32(steps), jnp.float32(repeat_action_probability), jnp.int32(noop_max))
-
-
-_CONFIG_FIELDS = {f.name for f in dataclasses.fields(EnvConfig)}
-_PARAM_FIELDS = {"max_episode_steps", "repeat_action_probability", "noop_max"}
-
-
-def make(game: Union[str, GameSpec], *, rom=None, **overrides: Any) -> tuple[Env, EnvParams]:
-    """Builds the env for a registered game id (or your own `GameSpec`) and its default params.
+def make(game: Union[str, GameSpec], *, rom=None, **options: Any) -> tuple[Env, EnvParams]:
+    """Builds the env for a registered game id (or your own `GameSpec`) and its params.
 
     Args:
         game: an id from `list_games()`, or a `GameSpec`.
         rom: an explicit ROM path (its SHA-1 must match the spec's).
-        **overrides: `EnvConfig` fields (frames_per_step, instructions_per_frame, obs_scale,
-            freeze_timers, autoreset) and `EnvParams` fields (max_episode_steps,
-            repeat_action_probability, noop_max).
+        **options: `EnvConfig` and `EnvParams` fields (`octax_core.env.config.ENV_OPTIONS`:
+            frames_per_step, instructions_per_frame, obs_scale, freeze_timers, noop_max,
+            autoreset, max_episode_steps, repeat_action_probability).
 
     Raises:
         KeyError: unknown game id (the message lists the valid ids).
-        TypeError: an unknown override (the message lists the valid ones).
-        ValueError: an override out of range.
+        TypeError: an unknown option (the message lists the valid ones).
+        ValueError: an option out of range.
 
     >>> env, params = make("Pong")                                   # doctest: +SKIP
     >>> obs, state = env.reset(jax.random.key(0), params)            # doctest: +SKIP
     """
     spec = game if isinstance(game, GameSpec) else get_spec(game)
-    config, params = make_config(spec, **overrides)
+    config, params = make_config(spec, **options)
     return Env(spec, config, rom), params
-
-
-def make_config(spec: GameSpec, **overrides: Any) -> tuple[EnvConfig, EnvParams]:
-    """The checked `EnvConfig` and `EnvParams` that `make` would use, without booting the ROM.
-
-    Raises:
-        TypeError: an unknown override (the message lists the valid ones).
-        ValueError: an override out of range.
-    """
-    unknown = set(overrides) - _CONFIG_FIELDS - _PARAM_FIELDS
-    if unknown:
-        raise TypeError(f"unknown override(s) {sorted(unknown)}; valid: {sorted(_CONFIG_FIELDS | _PARAM_FIELDS)}")
-    config_args = {k: v for k, v in overrides.items() if k in _CONFIG_FIELDS}
-    if config_args.get("freeze_timers") is None:
-        config_args["freeze_timers"] = spec.freeze_timers
-    config = EnvConfig(**config_args)
-    _check_config(config)
-    params = make_params(spec, **{k: v for k, v in overrides.items() if k in _PARAM_FIELDS})
-    return config, params
-
-
-def _check_config(config: EnvConfig) -> None:
-    for name in ("frames_per_step", "instructions_per_frame"):
-        value = getattr(config, name)
-        if isinstance(value, bool) or not isinstance(value, int) or value <= 0:
-            raise ValueError(f"{name} must be a positive int, got {value!r}")
-    if config.obs_scale not in (1, 255):
-        raise ValueError(f"obs_scale must be 1 (pixels 0/1) or 255 (pixels 0/255), got {config.obs_scale!r}")
-    for name in ("freeze_timers", "autoreset"):
-        if not isinstance(getattr(config, name), bool):
-            raise ValueError(f"{name} must be True or False, got {getattr(config, name)!r}")

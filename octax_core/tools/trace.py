@@ -174,13 +174,12 @@ def _rollout(env: Env, policy: str, stall_steps: int):
             state, still = carry
             action_key, step_key, reset_key = jax.random.split(key, 3)
             action = jax.random.randint(action_key, (), 0, env.num_actions) if policy == "random" else 0
-            _, after, reward, terminated, truncated, _ = env.step(step_key, state, action, params)
+            obs, after, reward, terminated, truncated, _ = env.step(step_key, state, action, params)
             still = jnp.where(_unchanged(state.machine, after.machine), still + 1, 0)
             if stall_steps:
                 terminated = terminated | (still >= stall_steps)
-            ended = terminated | truncated
-            _, fresh = env.reset(reset_key, params)
-            state = jax.tree.map(lambda new, old: jnp.where(ended, new, old), fresh, after)
+            ended = terminated | truncated  # the stall rule is the trace's own, so not `after.done`
+            _, state = env.autoreset(reset_key, ended, obs, after, params)
             out = (after.machine.V, after.machine.pc, reward, terminated, truncated & ~terminated)
             return (state, jnp.where(ended, 0, still)), out
 

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import jax
 import numpy as np
 import pytest
 
@@ -50,9 +51,15 @@ def test_custom_palette_pair():
     assert tuple(frame[2, 127]) == (1, 2, 3)
 
 
-def test_unpack_words_matches_the_core():
+def test_the_one_unpacker_gives_numpy_on_the_host_and_the_same_pixels_under_jit():
     words = np.random.default_rng(0).integers(0, 2**32, size=(5, 32, 2), dtype=np.uint64).astype(np.uint32)
-    np.testing.assert_array_equal(render.unpack_words(words), np.asarray(octax_core.emulator.state.unpack_screen(words)))
+    on_host = octax_core.emulator.state.unpack_screen(words)
+    assert isinstance(on_host, np.ndarray) and on_host.dtype == np.bool_ and on_host.shape == (5, 32, 64)
+    jitted = jax.jit(octax_core.emulator.state.unpack_screen)(words)
+    np.testing.assert_array_equal(on_host, np.asarray(jitted))
+    # Pixel x of row y is bit 31 - x % 32 of word x // 32, written out the slow way.
+    slow = [[[bool(words[i, y, x // 32] >> (31 - x % 32) & 1) for x in range(64)] for y in range(32)] for i in range(5)]
+    np.testing.assert_array_equal(on_host, np.array(slow))
 
 
 def test_tile_makes_an_even_sided_grid():
