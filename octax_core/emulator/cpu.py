@@ -9,11 +9,13 @@ mirror), one sprite read and XOR, and a few lane selects on the registers and th
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import jax
 import jax.numpy as jnp
 
-from octax_core.emulator.decode import Kind, decode
-from octax_core.emulator.ops import Context, alu, display, flow, keys, memory, timers
+from octax_core.emulator.decode import Decoded, Kind, decode
+from octax_core.emulator.ops import Context, Effect, alu, display, flow, keys, memory, timers
 from octax_core.emulator.quirks import Quirks
 from octax_core.emulator.rom import MEMORY_SIZE
 from octax_core.emulator.state import MEMORY_OFFSET, MachineState
@@ -56,58 +58,64 @@ HANDLERS = {
     Kind.LOAD: memory.op_fx65,
 }  # Kind.NOP has no handler: every field keeps its default
 
-EFFECT_FIELDS = {
-    "pc": "next pc (default pc + 2)",
-    "vx": "new value of Vx (default unchanged)",
-    "vf": "flag written to VF after vx (default none)",
-    "i": "new I (default unchanged)",
-    "sp": "new stack pointer (default unchanged)",
-    "push": "return address written to stack[sp] (default none)",
-    "mem_data": "(16,) bytes to write at I (default: the bytes already there)",
-    "mem_count": "how many of mem_data to write (default 0)",
-    "load_count": "load V0..V(count-1) from memory at I (default 0)",
-    "delay_timer": "new delay timer (default unchanged)",
-    "sound_timer": "new sound timer (default unchanged)",
-    "rng": "new xorshift32 state (default unchanged)",
-    "key_wait": "new FX0A progress (default unchanged)",
-    "clear": "clear the screen first (default False)",
-}
+class Fetched(NamedTuple):
+    """The instruction at pc, decoded, and the context its handler reads."""
+
+    fields: Decoded
+    kind: jax.Array  # int32 Kind; STALL while the frame is over (display wait)
+    context: Context
 
 
-def _lanes():
-    return jnp.arange(16, dtype=jnp.int32)
+def fetch(quirks: Quirks, state: MachineState, keys: jax.Array, stalled=None) -> Fetched:
+    """Reads the opcode at pc and the 16 bytes at I, decodes, and builds the handlers' context.
+
+    Both reads are contiguous slices thanks to the RAM mirror (`state.MEMORY_OFFSET`): the
+    window at I serves FX65's loads and the read half of FX33/FX55's read-modify-write.
+    """
+    pc, I = state.pc.astype(jnp.int32), state.I.astype(jnp.int32)
+    opcode = jax.lax.dynamic_slice(state.memory, (pc + MEMORY_OFFSET,), (2,)).astype(jnp.int32)
+    window = jax.lax.dynamic_slice(state.memory, (I + MEMORY_OFFSET,), (16,)).astype(jnp.int32)
+    fields = decode(opcode[0], opcode[1])
+    kind = fields.kind if stalled is None else jnp.where(stalled, int(Kind.STALL), fields.kind)
+    V, sp = state.V.astype(jnp.int32), state.sp.astype(jnp.int32)
+    context = Context(
+        quirks=quirks, x=fields.x, y=fields.y, n=fields.n, nn=fields.nn, nnn=fields.nnn, vx=V[fields.x],
+        vy=V[fields.y], v0=V[0], pc=pc, I=I, sp=sp, stack_top=state.stack[(sp - 1) & 0xF].astype(jnp.int32),
+        V=V, window=window, collision=jnp.bool_(False), keys=keys,
+        delay_timer=state.delay_timer.astype(jnp.int32), rng=state.rng, key_wait=state.key_wait.astype(jnp.int32),
+    )
+    return Fetched(fields, kind, context)
 
 
-def _merge(kind, effects: dict, field: str, default):
-    """The value of `field` chosen by `kind` among the handlers that set it, else `default`."""
-    value = default
-    for handler_kind, effect in effects.items():
-        if field in effect:
-            value = jnp.where(kind == handler_kind, effect[field], value)
-    return value
+def merge(kind, effects: dict, defaults: Effect) -> Effect:
+    """One effect: each field the value of the handler `kind` selects, where that handler sets
+    it, else the field of `defaults`. A chain of scalar selects per field, no branching."""
+    merged = {}
+    for field, default in zip(Effect._fields, defaults):
+        value = default
+        for handler_kind, effect in effects.items():
+            if getattr(effect, field) is not None:
+                value = jnp.where(kind == handler_kind, getattr(effect, field), value)
+        merged[field] = value
+    return Effect(**merged)
 
 
-def _writes(kind, effects: dict, field: str):
-    """Whether the handler chosen by `kind` sets `field`."""
-    kinds = [k for k, effect in effects.items() if field in effect]
+def sets(kind, effects: dict, field: str) -> jax.Array:
+    """Whether the handler `kind` selects sets `field` (for fields with no neutral default)."""
+    kinds = [k for k, effect in effects.items() if getattr(effect, field) is not None]
     return jnp.isin(kind, jnp.asarray(kinds, jnp.int32))
 
 
-def _context(quirks: Quirks, state: MachineState, keys, kind_fields, window, collision):
-    V = state.V.astype(jnp.int32)
-    sp = state.sp.astype(jnp.int32)
-    return Context(
-        quirks=quirks, x=kind_fields.x, y=kind_fields.y, n=kind_fields.n, nn=kind_fields.nn,
-        nnn=kind_fields.nnn, vx=V[kind_fields.x], vy=V[kind_fields.y], v0=V[0],
-        pc=state.pc.astype(jnp.int32), I=state.I.astype(jnp.int32), sp=sp,
-        stack_top=state.stack[(sp - 1) & 0xF].astype(jnp.int32), V=V, window=window,
-        collision=collision, keys=keys, delay_timer=state.delay_timer.astype(jnp.int32),
-        rng=state.rng, key_wait=state.key_wait.astype(jnp.int32),
-    )
+def _defaults(state: MachineState, c: Context) -> Effect:
+    """What an instruction leaves alone: pc moves on by 2, everything else stays as it is."""
+    return Effect(pc=c.pc + 2, vx=c.vx, vf=jnp.int32(0), i=c.I, sp=c.sp, push=c.pc, mem_data=c.window,
+                  mem_count=jnp.int32(0), load_count=jnp.int32(0), delay_timer=c.delay_timer,
+                  sound_timer=state.sound_timer.astype(jnp.int32), rng=c.rng, key_wait=c.key_wait,
+                  clear=jnp.bool_(False))
 
 
 def execute(quirks: Quirks, state: MachineState, keys: jax.Array, stalled=None):
-    """Runs the instruction at pc.
+    """Runs the instruction at pc: fetch and decode, every handler, merge, apply.
 
     Args:
         quirks: the interpreter behaviour (static).
@@ -118,60 +126,56 @@ def execute(quirks: Quirks, state: MachineState, keys: jax.Array, stalled=None):
     Returns:
         (new state, whether a DXYN ran).
     """
-    lanes = _lanes()
-    pc, I = state.pc.astype(jnp.int32), state.I.astype(jnp.int32)
-    # Contiguous slices thanks to the mirror: the opcode at pc, and 16 bytes at I (FX65 loads
-    # and the read half of FX33/FX55's read-modify-write).
-    opcode = jax.lax.dynamic_slice(state.memory, (pc + MEMORY_OFFSET,), (2,)).astype(jnp.int32)
-    window = jax.lax.dynamic_slice(state.memory, (I + MEMORY_OFFSET,), (16,)).astype(jnp.int32)
-    fields = decode(opcode[0], opcode[1])
-    kind = fields.kind if stalled is None else jnp.where(stalled, int(Kind.STALL), fields.kind)
-
+    fetched = fetch(quirks, state, keys, stalled)
+    kind, c = fetched.kind, fetched.context
     # The memory write goes first and DXYN, the one handler that reads the collision, after it,
     # taking its sprite from the written memory: DXYN writes no memory, so those are the same
     # bytes, and XLA never has to copy the memory buffer to keep the old version alive.
-    c = _context(quirks, state, keys, fields, window, collision=jnp.bool_(False))
     effects = {k: handler(c) for k, handler in HANDLERS.items() if k != Kind.DRW}
-    unknown = {field for effect in effects.values() for field in effect} - EFFECT_FIELDS.keys()
-    if unknown:  # checked while tracing, so it costs nothing per instruction
-        raise RuntimeError(f"handlers returned unknown effect fields {sorted(unknown)}")
-
-    def merged(field, default):
-        return _merge(kind, effects, field, default)
-
-    mem_count = merged("mem_count", jnp.int32(0))
-    written = jnp.where(lanes < mem_count, merged("mem_data", c.window), c.window)
-    new_memory = _write_window(state.memory, written.astype(jnp.uint8), I)
-
-    y = c.vy & 31
-    aligned = jax.lax.dynamic_slice(new_memory, (I - y + MEMORY_OFFSET,),
-                                    (32 if quirks.clipping else 64,))
-    mask = display.sprite_mask(aligned.astype(jnp.int32), c.vx & 63, y,
-                               jnp.where(kind == Kind.DRW, fields.n, 0), quirks.clipping)
-    collision = display.collides(state.screen, mask)
-    effects[Kind.DRW] = display.op_dxyn(c._replace(collision=collision))
-
-    # Registers by lane selects, with VF after Vx; a scatter at x would cost more under vmap.
-    V = jnp.where(lanes < merged("load_count", jnp.int32(0)), c.window, c.V)
-    V = jnp.where(lanes == c.x, merged("vx", c.vx), V)
-    V = jnp.where((lanes == 15) & _writes(kind, effects, "vf"), merged("vf", jnp.int32(0)), V)
-
-    keep = jnp.where(merged("clear", jnp.bool_(False)), jnp.uint32(0), jnp.uint32(0xFFFFFFFF))
-    pushing = (lanes == c.sp) & _writes(kind, effects, "push")
-    new_state = MachineState(
-        memory=new_memory,
-        V=V.astype(jnp.uint8),
-        I=(merged("i", c.I) & 0xFFF).astype(jnp.uint16),
-        pc=(merged("pc", c.pc + 2) & 0xFFF).astype(jnp.uint16),
-        sp=merged("sp", c.sp).astype(jnp.uint8),
-        stack=jnp.where(pushing, merged("push", c.pc) & 0xFFF, state.stack).astype(jnp.uint16),
-        delay_timer=merged("delay_timer", c.delay_timer).astype(jnp.uint8),
-        sound_timer=merged("sound_timer", state.sound_timer.astype(jnp.int32)).astype(jnp.uint8),
-        screen=(state.screen & keep) ^ mask,
-        rng=merged("rng", c.rng),
-        key_wait=merged("key_wait", c.key_wait).astype(jnp.uint8),
-    )
+    defaults = _defaults(state, c)
+    memory = _write_memory(state.memory, merge(kind, effects, defaults), c)
+    sprite = _sprite_mask(quirks, memory, c, jnp.where(kind == Kind.DRW, fetched.fields.n, 0))
+    effects[Kind.DRW] = display.op_dxyn(c._replace(collision=display.collides(state.screen, sprite)))
+    new_state = _apply(state, kind, effects, merge(kind, effects, defaults), memory, sprite, c)
     return new_state, kind == Kind.DRW
+
+
+def _write_memory(memory, effect: Effect, c: Context):
+    """The merged effect's memory write: its first mem_count bytes at I, the rest unchanged."""
+    lanes = jnp.arange(16, dtype=jnp.int32)
+    written = jnp.where(lanes < effect.mem_count, effect.mem_data, c.window)
+    return _write_window(memory, written.astype(jnp.uint8), c.I)
+
+
+def _sprite_mask(quirks: Quirks, memory, c: Context, height):
+    """The XOR mask of the sprite a DXYN draws (all zero for any other instruction: height 0)."""
+    y = c.vy & 31
+    aligned = jax.lax.dynamic_slice(memory, (c.I - y + MEMORY_OFFSET,), (32 if quirks.clipping else 64,))
+    return display.sprite_mask(aligned.astype(jnp.int32), c.vx & 63, y, height, quirks.clipping)
+
+
+def _apply(state: MachineState, kind, effects: dict, effect: Effect, memory, sprite, c: Context) -> MachineState:
+    """The merged effect applied once: registers by lane selects with VF after Vx (a scatter at
+    x would cost more under vmap), the stack push, I, pc, timers, the screen."""
+    lanes = jnp.arange(16, dtype=jnp.int32)
+    V = jnp.where(lanes < effect.load_count, c.window, c.V)
+    V = jnp.where(lanes == c.x, effect.vx, V)
+    V = jnp.where((lanes == 15) & sets(kind, effects, "vf"), effect.vf, V)
+    keep = jnp.where(effect.clear, jnp.uint32(0), jnp.uint32(0xFFFFFFFF))
+    pushing = (lanes == c.sp) & sets(kind, effects, "push")
+    return MachineState(
+        memory=memory,
+        V=V.astype(jnp.uint8),
+        I=(effect.i & 0xFFF).astype(jnp.uint16),
+        pc=(effect.pc & 0xFFF).astype(jnp.uint16),
+        sp=effect.sp.astype(jnp.uint8),
+        stack=jnp.where(pushing, effect.push & 0xFFF, state.stack).astype(jnp.uint16),
+        delay_timer=effect.delay_timer.astype(jnp.uint8),
+        sound_timer=effect.sound_timer.astype(jnp.uint8),
+        screen=(state.screen & keep) ^ sprite,
+        rng=effect.rng,
+        key_wait=effect.key_wait.astype(jnp.uint8),
+    )
 
 
 def _write_window(memory, window, I):

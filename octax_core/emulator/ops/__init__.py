@@ -1,15 +1,14 @@
 """Instruction handlers, one tiny function per opcode, grouped by family.
 
-A handler takes the `Context` of the instruction being executed and returns an effect: a dict
-holding only the fields it changes (`octax_core.emulator.cpu.EFFECT_FIELDS` lists them). Handlers never
-build a state; `octax_core.emulator.cpu` merges the effects field by field and applies the result once,
-so under `vmap` each field pays for a few scalar selects instead of every handler copying 4 KB
-of memory.
+A handler takes the `Context` of the instruction being executed and returns an `Effect` that
+sets only the fields it changes. Handlers never build a state; `octax_core.emulator.cpu` merges
+the effects field by field and applies the result once, so under `vmap` each field pays for a
+few scalar selects instead of every handler copying 4 KB of memory.
 """
 
 from __future__ import annotations
 
-from typing import NamedTuple
+from typing import NamedTuple, Optional
 
 import jax
 
@@ -39,6 +38,26 @@ class Context(NamedTuple):
     delay_timer: jax.Array
     rng: jax.Array  # uint32
     key_wait: jax.Array
+
+
+class Effect(NamedTuple):
+    """What one instruction changes. A field left None is one the handler does not touch; the
+    merged effect (`octax_core.emulator.cpu.merge`) fills it with the default given here."""
+
+    pc: Optional[jax.Array] = None  # next pc (default pc + 2)
+    vx: Optional[jax.Array] = None  # new value of Vx (default unchanged)
+    vf: Optional[jax.Array] = None  # flag written to VF after vx (default none)
+    i: Optional[jax.Array] = None  # new I (default unchanged)
+    sp: Optional[jax.Array] = None  # new stack pointer (default unchanged)
+    push: Optional[jax.Array] = None  # return address written to stack[sp] (default none)
+    mem_data: Optional[jax.Array] = None  # (16,) bytes to write at I (default: the bytes there)
+    mem_count: Optional[jax.Array] = None  # how many of mem_data to write (default 0)
+    load_count: Optional[jax.Array] = None  # load V0..V(count-1) from memory at I (default 0)
+    delay_timer: Optional[jax.Array] = None  # new delay timer (default unchanged)
+    sound_timer: Optional[jax.Array] = None  # new sound timer (default unchanged)
+    rng: Optional[jax.Array] = None  # new xorshift32 state (default unchanged)
+    key_wait: Optional[jax.Array] = None  # new FX0A progress (default unchanged)
+    clear: Optional[jax.Array] = None  # clear the screen before the sprite (default False)
 
 
 def next_pc(c: Context, skip) -> jax.Array:

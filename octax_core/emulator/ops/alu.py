@@ -4,74 +4,74 @@ from __future__ import annotations
 
 import jax.numpy as jnp
 
-from octax_core.emulator.ops import Context
+from octax_core.emulator.ops import Context, Effect
 
 
-def op_6xnn(c: Context) -> dict:
+def op_6xnn(c: Context) -> Effect:
     """LD Vx, nn."""
-    return {"vx": c.nn}
+    return Effect(vx=c.nn)
 
 
-def op_7xnn(c: Context) -> dict:
+def op_7xnn(c: Context) -> Effect:
     """ADD Vx, nn; no carry flag."""
-    return {"vx": (c.vx + c.nn) & 0xFF}
+    return Effect(vx=(c.vx + c.nn) & 0xFF)
 
 
-def op_8xy0(c: Context) -> dict:
+def op_8xy0(c: Context) -> Effect:
     """LD Vx, Vy."""
-    return {"vx": c.vy}
+    return Effect(vx=c.vy)
 
 
-def _logic(c: Context, value) -> dict:
+def _logic(c: Context, value) -> Effect:
     # COSMAC VIP's logic ops ran through a routine that clobbered VF.
-    return {"vx": value, "vf": jnp.int32(0)} if c.quirks.vf_reset else {"vx": value}
+    return Effect(vx=value, vf=jnp.int32(0)) if c.quirks.vf_reset else Effect(vx=value)
 
 
-def op_8xy1(c: Context) -> dict:
+def op_8xy1(c: Context) -> Effect:
     """OR Vx, Vy; VF = 0 with vf_reset."""
     return _logic(c, c.vx | c.vy)
 
 
-def op_8xy2(c: Context) -> dict:
+def op_8xy2(c: Context) -> Effect:
     """AND Vx, Vy; VF = 0 with vf_reset."""
     return _logic(c, c.vx & c.vy)
 
 
-def op_8xy3(c: Context) -> dict:
+def op_8xy3(c: Context) -> Effect:
     """XOR Vx, Vy; VF = 0 with vf_reset."""
     return _logic(c, c.vx ^ c.vy)
 
 
-def op_8xy4(c: Context) -> dict:
+def op_8xy4(c: Context) -> Effect:
     """ADD Vx, Vy; VF = carry."""
     total = c.vx + c.vy
-    return {"vx": total & 0xFF, "vf": (total >> 8).astype(jnp.int32)}
+    return Effect(vx=total & 0xFF, vf=(total >> 8).astype(jnp.int32))
 
 
-def op_8xy5(c: Context) -> dict:
+def op_8xy5(c: Context) -> Effect:
     """SUB Vx, Vy; VF = 1 when there is no borrow."""
-    return {"vx": (c.vx - c.vy) & 0xFF, "vf": (c.vx >= c.vy).astype(jnp.int32)}
+    return Effect(vx=(c.vx - c.vy) & 0xFF, vf=(c.vx >= c.vy).astype(jnp.int32))
 
 
-def op_8xy7(c: Context) -> dict:
+def op_8xy7(c: Context) -> Effect:
     """SUBN Vx, Vy: Vx = Vy - Vx; VF = 1 when there is no borrow."""
-    return {"vx": (c.vy - c.vx) & 0xFF, "vf": (c.vy >= c.vx).astype(jnp.int32)}
+    return Effect(vx=(c.vy - c.vx) & 0xFF, vf=(c.vy >= c.vx).astype(jnp.int32))
 
 
 def _shift_source(c: Context):
     return c.vy if c.quirks.shift_uses_vy else c.vx
 
 
-def op_8xy6(c: Context) -> dict:
+def op_8xy6(c: Context) -> Effect:
     """SHR Vx {, Vy}; VF = the bit shifted out."""
     source = _shift_source(c)
-    return {"vx": source >> 1, "vf": source & 1}
+    return Effect(vx=source >> 1, vf=source & 1)
 
 
-def op_8xye(c: Context) -> dict:
+def op_8xye(c: Context) -> Effect:
     """SHL Vx {, Vy}; VF = the bit shifted out."""
     source = _shift_source(c)
-    return {"vx": (source << 1) & 0xFF, "vf": source >> 7}
+    return Effect(vx=(source << 1) & 0xFF, vf=source >> 7)
 
 
 def xorshift32(r):
@@ -81,7 +81,7 @@ def xorshift32(r):
     return r ^ (r << 5)
 
 
-def op_cxnn(c: Context) -> dict:
+def op_cxnn(c: Context) -> Effect:
     """RND Vx, nn: Vx = random byte AND nn."""
     rng = xorshift32(c.rng)
-    return {"vx": (rng >> 24).astype(jnp.int32) & c.nn, "rng": rng}
+    return Effect(vx=(rng >> 24).astype(jnp.int32) & c.nn, rng=rng)

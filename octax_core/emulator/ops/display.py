@@ -10,7 +10,7 @@ from __future__ import annotations
 import jax
 import jax.numpy as jnp
 
-from octax_core.emulator.ops import Context
+from octax_core.emulator.ops import Context, Effect
 from octax_core.emulator.state import SCREEN_HEIGHT
 
 
@@ -59,11 +59,11 @@ def collides(screen, mask) -> jax.Array:
     return hits != 0
 
 
-def op_00e0(c: Context) -> dict:
+def op_00e0(c: Context) -> Effect:
     """CLS."""
-    return {"clear": jnp.bool_(True)}
+    return Effect(clear=jnp.bool_(True))
 
 
-def op_dxyn(c: Context) -> dict:
+def op_dxyn(c: Context) -> Effect:
     """DRW Vx, Vy, n: XOR an n-row sprite from [I]; VF = collision."""
-    return {"vf": c.collision.astype(jnp.int32)}
+    return Effect(vf=c.collision.astype(jnp.int32))

@@ -2,49 +2,49 @@
 
 from __future__ import annotations
 
-from octax_core.emulator.ops import Context, next_pc
+from octax_core.emulator.ops import Context, Effect, next_pc
 
 
-def op_00ee(c: Context) -> dict:
+def op_00ee(c: Context) -> Effect:
     """RET: pop the return address."""
-    return {"pc": c.stack_top, "sp": (c.sp - 1) & 0xF}
+    return Effect(pc=c.stack_top, sp=(c.sp - 1) & 0xF)
 
 
-def op_1nnn(c: Context) -> dict:
+def op_1nnn(c: Context) -> Effect:
     """JP nnn."""
-    return {"pc": c.nnn}
+    return Effect(pc=c.nnn)
 
 
-def op_2nnn(c: Context) -> dict:
+def op_2nnn(c: Context) -> Effect:
     """CALL nnn: push pc + 2."""
-    return {"pc": c.nnn, "sp": (c.sp + 1) & 0xF, "push": c.pc + 2}
+    return Effect(pc=c.nnn, sp=(c.sp + 1) & 0xF, push=c.pc + 2)
 
 
-def op_3xnn(c: Context) -> dict:
+def op_3xnn(c: Context) -> Effect:
     """SE Vx, nn: skip if equal."""
-    return {"pc": next_pc(c, c.vx == c.nn)}
+    return Effect(pc=next_pc(c, c.vx == c.nn))
 
 
-def op_4xnn(c: Context) -> dict:
+def op_4xnn(c: Context) -> Effect:
     """SNE Vx, nn: skip if not equal."""
-    return {"pc": next_pc(c, c.vx != c.nn)}
+    return Effect(pc=next_pc(c, c.vx != c.nn))
 
 
-def op_5xy0(c: Context) -> dict:
+def op_5xy0(c: Context) -> Effect:
     """SE Vx, Vy: skip if equal."""
-    return {"pc": next_pc(c, c.vx == c.vy)}
+    return Effect(pc=next_pc(c, c.vx == c.vy))
 
 
-def op_9xy0(c: Context) -> dict:
+def op_9xy0(c: Context) -> Effect:
     """SNE Vx, Vy: skip if not equal."""
-    return {"pc": next_pc(c, c.vx != c.vy)}
+    return Effect(pc=next_pc(c, c.vx != c.vy))
 
 
-def op_bnnn(c: Context) -> dict:
+def op_bnnn(c: Context) -> Effect:
     """JP V0, nnn (or JP Vx, xnn with jump_uses_vx)."""
-    return {"pc": c.nnn + (c.vx if c.quirks.jump_uses_vx else c.v0)}
+    return Effect(pc=c.nnn + (c.vx if c.quirks.jump_uses_vx else c.v0))
 
 
-def op_stall(c: Context) -> dict:
+def op_stall(c: Context) -> Effect:
     """Not an opcode: the frame has ended (display wait), so nothing moves, pc included."""
-    return {"pc": c.pc}
+    return Effect(pc=c.pc)

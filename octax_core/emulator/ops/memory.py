@@ -4,41 +4,42 @@ from __future__ import annotations
 
 import jax.numpy as jnp
 
-from octax_core.emulator.ops import Context
+from octax_core.emulator.ops import Context, Effect
 from octax_core.emulator.state import FONT_ADDRESS
 
 
-def op_annn(c: Context) -> dict:
+def op_annn(c: Context) -> Effect:
     """LD I, nnn."""
-    return {"i": c.nnn}
+    return Effect(i=c.nnn)
 
 
-def op_fx1e(c: Context) -> dict:
+def op_fx1e(c: Context) -> Effect:
     """ADD I, Vx; VF untouched."""
-    return {"i": c.I + c.vx}
+    return Effect(i=c.I + c.vx)
 
 
-def op_fx29(c: Context) -> dict:
+def op_fx29(c: Context) -> Effect:
     """LD F, Vx: I = address of the font glyph for the low nibble of Vx."""
-    return {"i": FONT_ADDRESS + 5 * (c.vx & 0xF)}
+    return Effect(i=FONT_ADDRESS + 5 * (c.vx & 0xF))
 
 
-def op_fx33(c: Context) -> dict:
+def op_fx33(c: Context) -> Effect:
     """LD B, Vx: memory[I..I+2] = decimal digits of Vx."""
     digits = jnp.stack([c.vx // 100, (c.vx // 10) % 10, c.vx % 10])
-    return {"mem_data": jnp.pad(digits, (0, 13)), "mem_count": jnp.int32(3)}
+    return Effect(mem_data=jnp.pad(digits, (0, 13)), mem_count=jnp.int32(3))
 
 
-def _after_transfer(c: Context) -> dict:
-    return {"i": c.I + c.x + 1} if c.quirks.memory_increment else {}
+def _i_after_transfer(c: Context):
+    """I after FX55/FX65: advanced by X + 1 with memory_increment, else untouched (None)."""
+    return c.I + c.x + 1 if c.quirks.memory_increment else None
 
 
-def op_fx55(c: Context) -> dict:
+def op_fx55(c: Context) -> Effect:
     """LD [I], V0..Vx; I += x + 1 with memory_increment."""
-    return {"mem_data": c.V, "mem_count": c.x + 1, **_after_transfer(c)}
+    return Effect(mem_data=c.V, mem_count=c.x + 1, i=_i_after_transfer(c))
 
 
-def op_fx65(c: Context) -> dict:
+def op_fx65(c: Context) -> Effect:
     """LD V0..Vx, [I]; I += x + 1 with memory_increment."""
     # vx is named too: the effect writes Vx after the bulk load and must not undo it.
-    return {"load_count": c.x + 1, "vx": c.window[c.x], **_after_transfer(c)}
+    return Effect(load_count=c.x + 1, vx=c.window[c.x], i=_i_after_transfer(c))

@@ -2,19 +2,19 @@
 
 from __future__ import annotations
 
-from octax_core.emulator.ops import Context
+from octax_core.emulator.ops import Context, Effect
 
 
-def op_fx07(c: Context) -> dict:
+def op_fx07(c: Context) -> Effect:
     """LD Vx, DT."""
-    return {"vx": c.delay_timer}
+    return Effect(vx=c.delay_timer)
 
 
-def op_fx15(c: Context) -> dict:
+def op_fx15(c: Context) -> Effect:
     """LD DT, Vx."""
-    return {"delay_timer": c.vx}
+    return Effect(delay_timer=c.vx)
 
 
-def op_fx18(c: Context) -> dict:
+def op_fx18(c: Context) -> Effect:
     """LD ST, Vx."""
-    return {"sound_timer": c.vx}
+    return Effect(sound_timer=c.vx)
