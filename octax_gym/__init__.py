@@ -12,6 +12,7 @@ single env. This package imports `octax_core`, never the reverse; torch, SB3 and
 imported only when asked for. See docs/gymnasium.md.
 """
 
+from octax_gym.action_check import InvalidActionError
 from octax_gym.env import OctaxEnv
 from octax_gym.registration import NAMESPACE, env_id, register_all, register_game
 from octax_gym.render import PALETTES
@@ -33,4 +34,4 @@ def __getattr__(name: str):
     raise AttributeError(f"module 'octax_gym' has no attribute {name!r}")
 
 
-__all__ = ["ENV_IDS", "NAMESPACE", "OctaxEnv", "OctaxVectorEnv", "PALETTES", "env_id", "register_all", "register_game", *_LAZY]
+__all__ = ["ENV_IDS", "InvalidActionError", "NAMESPACE", "OctaxEnv", "OctaxVectorEnv", "PALETTES", "env_id", "register_all", "register_game", *_LAZY]

@@ -69,37 +69,52 @@ def to_backend(tree, backend: str):
     return jax.tree.map(torch.from_dlpack, tree)
 
 
-def actions_to_jax(actions, num_envs: int, num_actions: int, device: jax.Device, game: str) -> jax.Array:
-    """Checks a batch of actions (numpy, list, jax or torch) and puts it on the env's device.
+def actions_to_device(actions, num_envs: int, num_actions: int, device: jax.Device,
+                      game: str) -> tuple[jax.Array, bool]:
+    """A batch of actions (numpy, list, jax or torch) as an int32 JAX array on the env's device.
 
-    The checks run on the host before the jitted step, which cannot raise: shape (num_envs,),
-    an integer dtype, every value in 0..num_actions-1.
+    Everything is checked that can be without waiting for a device: the type, the integer
+    dtype and the shape (num_envs,) always, from metadata; the values too when they are on the
+    host (numpy, lists). JAX arrays and torch tensors are never read here: their range is checked
+    inside the jitted step (`octax_gym.action_check`).
+
+    Returns:
+        The actions, and whether their values are still unchecked (device inputs).
 
     Raises:
-        TypeError: wrong type or dtype. ValueError: wrong shape or a value out of range.
+        TypeError: wrong type or dtype. ValueError: wrong shape or a host value out of range.
     """
     torch = _torch_if_tensor(actions)
     if torch is not None:
         if actions.dtype.is_floating_point or actions.dtype.is_complex or actions.dtype == torch.bool:
             raise TypeError(f"{game}: actions must be integers, got a torch tensor of {actions.dtype}")
-        shape, array = tuple(actions.shape), actions.detach()
-        low, high = (int(array.min()), int(array.max())) if array.numel() else (0, 0)
-        array = jax.dlpack.from_dlpack(array.contiguous()) if array.device.type != "cpu" else array.numpy()
-    else:
-        array = actions if isinstance(actions, (jax.Array, np.ndarray)) else np.asarray(actions)
-        if not (np.issubdtype(array.dtype, np.integer)) or array.dtype == np.bool_:
-            raise TypeError(f"{game}: actions must be integers, got {array.dtype} "
-                            f"(expected shape ({num_envs},), values 0..{num_actions - 1})")
-        shape = tuple(array.shape)
-        host = np.asarray(array) if shape == (num_envs,) else None
-        low, high = (int(host.min()), int(host.max())) if host is not None and host.size else (0, 0)
-    if shape != (num_envs,):
-        raise ValueError(f"{game}: actions must have shape ({num_envs},), one per env, got {shape}")
-    if low < 0 or high >= num_actions:
-        bad = low if low < 0 else high
+        _check_shape(tuple(actions.shape), num_envs, game)
+        # A private int32 copy (an async op on the tensor's stream), handed over by DLPack: the
+        # caller may overwrite its tensor while the step still runs, and no value is read here.
+        copy = actions.detach().to(dtype=torch.int32, copy=True).contiguous()
+        return jax.device_put(jax.dlpack.from_dlpack(copy), device), True
+    if isinstance(actions, jax.Array):
+        _check_integer_dtype(actions.dtype, num_envs, num_actions, game)
+        _check_shape(actions.shape, num_envs, game)
+        return jax.device_put(actions.astype(jnp.int32), device), True
+    array = np.asarray(actions)
+    _check_integer_dtype(array.dtype, num_envs, num_actions, game)
+    _check_shape(array.shape, num_envs, game)
+    if array.size and (array.min() < 0 or array.max() >= num_actions):
+        bad = array.min() if array.min() < 0 else array.max()
         raise ValueError(f"{game}: action {bad} is out of range; valid actions are 0..{num_actions - 1}")
-    return jax.device_put(jnp.asarray(array, jnp.int32) if isinstance(array, jax.Array)
-                          else np.asarray(array, np.int32), device)
+    return jax.device_put(array.astype(np.int32), device), False
+
+
+def _check_integer_dtype(dtype, num_envs: int, num_actions: int, game: str) -> None:
+    if not np.issubdtype(dtype, np.integer) or dtype == np.bool_:
+        raise TypeError(f"{game}: actions must be integers, got {dtype} "
+                        f"(expected shape ({num_envs},), values 0..{num_actions - 1})")
+
+
+def _check_shape(shape: tuple, num_envs: int, game: str) -> None:
+    if tuple(shape) != (num_envs,):
+        raise ValueError(f"{game}: actions must have shape ({num_envs},), one per env, got {tuple(shape)}")
 
 
 def action_to_int(action, num_actions: int, game: str) -> int:

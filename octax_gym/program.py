@@ -11,7 +11,8 @@ what Gymnasium adds to the core:
 * Gymnasium's autoreset modes pick which rows the core's one `Env.autoreset` restarts: NEXT_STEP
   the rows that had ended before this step, SAME_STEP the rows that end in it, and a masked
   `reset` the rows asked for;
-* the info dict gets Gymnasium's `_name` masks, and SAME_STEP its batched `final_obs`/`final_info`.
+* the info dict gets Gymnasium's `_name` masks, and SAME_STEP its batched `final_obs`/`final_info`;
+* device actions get their range checked in the step (`octax_gym.action_check`).
 
 Programs are cached per (game, config, ROM), so every env of one game shares its compilations.
 """
@@ -28,6 +29,7 @@ from gymnasium.vector import AutoresetMode
 
 import octax_core
 from octax_core.env import ENV_OPTIONS, Env, EnvConfig, EnvParams, EnvState, GameSpec
+from octax_gym import action_check
 
 # What the Gymnasium envs pass to the core: every env option but `autoreset`, which Gymnasium's
 # own `autoreset_mode` replaces.
@@ -63,7 +65,10 @@ class Program:
             next_keys = select_keys(mask, next_keys, keys)
         return next_keys, obs, state, self._with_masks(self.info(state))
 
-    def _step(self, keys, state: EnvState, actions, params: EnvParams, *, mode: AutoresetMode):
+    def _step(self, keys, state: EnvState, actions, report, params: EnvParams, *, mode: AutoresetMode):
+        """One batched step; also returns the action report (`octax_gym.action_check`) updated
+        with this step's actions, as its last output."""
+        report = action_check.accumulate(report, actions, self.env.num_actions)
         next_keys, step_keys, reset_keys = jax.vmap(advance)(keys)
         was_done = state.done
         obs, state, reward, terminated, truncated, info = jax.vmap(
@@ -79,8 +84,9 @@ class Program:
             final = {"final_obs": obs, "_final_obs": ended,
                      "final_info": self._with_masks(info), "_final_info": ended}
             obs, state = self._autoreset(reset_keys, ended, obs, state, params)
-            return next_keys, obs, state, reward, terminated, truncated, {**self._with_masks(self.info(state)), **final}
-        return next_keys, obs, state, reward, terminated, truncated, self._with_masks(info)
+            info = {**self._with_masks(self.info(state)), **final}
+            return next_keys, obs, state, reward, terminated, truncated, info, report
+        return next_keys, obs, state, reward, terminated, truncated, self._with_masks(info), report
 
     @staticmethod
     def _with_masks(info: dict) -> dict:

@@ -21,7 +21,7 @@ import numpy as np
 from gymnasium import spaces
 from gymnasium.vector import AutoresetMode
 
-from octax_gym import backends, program, render
+from octax_gym import action_check, backends, program, render
 from octax_core.emulator.state import unpack_screen
 from octax_core.env.config import check_option_names
 from octax_core.validate import check_int
@@ -98,6 +98,7 @@ class OctaxVectorEnv(gymnasium.vector.VectorEnv):
         self.game_spec = self.core_env.spec
         self.params = jax.device_put(params, self.device)
         self._step_fn = self._program.step[self.autoreset_mode]
+        self._action_check = action_check.DeferredCheck(self.game_spec.id, self.core_env.num_actions, self.device)
 
         config = self.core_env.config
         self.metadata = {**type(self).metadata, "autoreset_mode": self.autoreset_mode,
@@ -114,6 +115,7 @@ class OctaxVectorEnv(gymnasium.vector.VectorEnv):
         """Resets every env, or with `options={"reset_mask": m}` (bool numpy array (num_envs,))
         only the rows where m is True. An int seed s seeds env i with s + i."""
         seeds = None if seed is None else seeds_for(seed, self.num_envs)  # checks the seed first
+        self._action_check.poll()  # earlier steps' device actions whose check has finished
         super().reset(seed=int(seed) if isinstance(seed, (int, np.integer)) else None)
         options = dict(options or {})
         mask = options.pop("reset_mask", None)
@@ -137,14 +139,25 @@ class OctaxVectorEnv(gymnasium.vector.VectorEnv):
         return backends.to_backend(self._obs, self.backend), backends.to_backend(info, self.backend)
 
     def step(self, actions):
-        """Steps every env with its action; one jitted call, no host sync inside it."""
+        """Steps every env with its action; one jitted call, no host sync inside it.
+
+        Actions are ints in 0..n-1, one per env: a numpy array or list (checked here: a bad one
+        raises before anything runs), or a JAX array or torch tensor (never read here, so the
+        step need not wait for whatever computes them: shape and dtype are checked at once,
+        the range inside the step, and `InvalidActionError` surfaces at a later call; see
+        `octax_gym.action_check`).
+        """
         if self._state is None:
             raise gymnasium.error.ResetNeeded("call reset() before step()")
-        actions = backends.actions_to_jax(actions, self.num_envs, self.single_action_space.n, self.device,
-                                          self.game_spec.id)
-        self._keys, self._obs, self._state, reward, terminated, truncated, info = self._step_fn(
-            self._keys, self._state, actions, self.params)
+        actions, unchecked = backends.actions_to_device(actions, self.num_envs, self.single_action_space.n,
+                                                        self.device, self.game_spec.id)
+        self._action_check.poll()
+        self._keys, self._obs, self._state, reward, terminated, truncated, info, report = self._step_fn(
+            self._keys, self._state, actions, self._action_check.report, self.params)
+        self._action_check.record(report, unchecked)
         out = backends.to_backend((self._obs, reward, terminated, truncated, info), self.backend)
+        if self.backend == "numpy":  # the outputs were just read back, so the report is ready too
+            self._action_check.poll(wait=True)
         return out
 
     def render(self) -> Optional[tuple[np.ndarray, ...]]:
@@ -159,6 +172,7 @@ class OctaxVectorEnv(gymnasium.vector.VectorEnv):
 
     def close_extras(self, **kwargs):
         self._keys = self._state = self._obs = None
+        self._action_check.poll(wait=True)  # the last steps' device actions, checked at the latest here
 
     # --- helpers ----------------------------------------------------------------------------
 

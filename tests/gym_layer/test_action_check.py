@@ -1,0 +1,144 @@
+"""Actions on a device are never read back on the step path, and a bad one still raises.
+
+On a CPU `jax.transfer_guard` sees no transfers (host and device memory are the same), so the
+tests check what a read would cost instead: the actions come from a computation that is still
+running when `step()` returns (reading them would have waited for it, and they would be ready),
+the Python-level reads of an unfinished JAX array (`int()`, `.item()`, `.tolist()`, `bool()`,
+`jax.device_get`: its `_value`) and every read of a torch tensor's values are made to fail. The
+guard is set too, for a GPU.
+"""
+
+from __future__ import annotations
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+import pytest
+from jax._src.array import ArrayImpl  # the one class behind jax.Array; its _value is every host read
+
+from counter_game import COUNTER
+from octax_gym import OctaxVectorEnv
+from octax_gym.action_check import MAX_PENDING, DeferredCheck, InvalidActionError, accumulate
+
+
+def _no_waiting_reads(monkeypatch):
+    """From here on, a Python-level read of an unfinished JAX array's values raises: it would
+    wait for the device. (The step path may read a finished action report, which waits for nothing.)"""
+    value = ArrayImpl._value
+
+    def read(self):
+        if not self.is_ready():
+            raise AssertionError("the step path read an unfinished device value back to the host")
+        return value.fget(self)
+    monkeypatch.setattr(ArrayImpl, "_value", property(read))
+
+
+@jax.jit
+def _slow_actions(actions):
+    """`actions`, after a few seconds of matrix products that decide nothing."""
+    m = jax.lax.fori_loop(0, 150, lambda i, m: jnp.tanh(m @ m / 1500.0), jnp.ones((1500, 1500), jnp.float32))
+    return actions + (m[0, 0] > 2.0).astype(actions.dtype)  # tanh keeps it below 1: adds 0
+
+
+@pytest.fixture
+def make_envs(counter_rom):
+    def build(backend, **kwargs):
+        return OctaxVectorEnv(COUNTER, 3, rom=counter_rom, backend=backend, **kwargs)
+    return build
+
+
+def test_jax_actions_are_never_read_on_the_step_path(make_envs, monkeypatch):
+    envs = make_envs("jax")
+    envs.reset(seed=0)
+    jax.block_until_ready(envs.step(jnp.array([0, 0, 0]))[0])  # compiled
+    jax.block_until_ready(_slow_actions(jnp.zeros(3, jnp.int32)))  # compiled
+    actions = _slow_actions(jnp.array([0, 1, 9]))  # 9 is out of range: found later, without reading it here
+    with monkeypatch.context() as patch, jax.transfer_guard_device_to_host("disallow"):
+        _no_waiting_reads(patch)
+        for _ in range(3):
+            obs, reward, terminated, truncated, info = envs.step(actions)
+            assert isinstance(reward, jax.Array)
+        envs.step(jnp.array([1, 1, 1]))
+    assert not actions.is_ready(), "step() waited for the actions' computation"
+    jax.block_until_ready(envs.state)
+    with pytest.raises(InvalidActionError, match=r"action 9 is out of range; valid actions are 0\.\.2 \(env 2"):
+        envs.step(jnp.array([0, 0, 0]))
+    obs, reward, *_ = envs.step(jnp.array([2, 2, 2]))  # after the error, a clean report
+    assert list(np.asarray(reward)) == [8.0, 8.0, 8.0]
+
+
+def test_torch_actions_are_never_read_on_the_step_path(make_envs, monkeypatch):
+    torch = pytest.importorskip("torch", reason="the torch extra is installed by `make test`")
+    envs = make_envs("torch")
+    envs.reset(seed=0)
+    actions = torch.tensor([0, 5, 1])
+
+    def read(*args, **kwargs):
+        raise AssertionError("the step path read a torch action on the host")
+    with monkeypatch.context() as patch, jax.transfer_guard_device_to_host("disallow"):
+        _no_waiting_reads(patch)
+        for name in ("item", "tolist", "numpy", "__int__", "__index__", "__bool__", "__array__", "min", "max"):
+            patch.setattr(torch.Tensor, name, read)
+        obs, reward, *_ = envs.step(actions)
+        actions[1] = 1  # the caller may reuse its tensor at once: the step took a private copy
+        assert reward.dtype == torch.float32
+    jax.block_until_ready(envs.state)
+    with pytest.raises(InvalidActionError, match=r"action 5 is out of range; valid actions are 0\.\.2 \(env 1"):
+        envs.reset(options={"reset_mask": np.ones(3, bool)})
+
+
+def test_numpy_backend_reports_a_bad_device_action_from_the_same_step(make_envs):
+    envs = make_envs("numpy")
+    envs.reset(seed=0)
+    with pytest.raises(InvalidActionError, match="action -4 is out of range"):
+        envs.step(jnp.array([0, -4, 1]))
+    _, reward, *_ = envs.step(jnp.array([1, 1, 1]))
+    assert list(reward) == [4.0, 4.0, 4.0]
+
+
+def test_close_raises_what_no_step_read_yet(make_envs):
+    envs = make_envs("jax")
+    envs.reset(seed=0)
+    envs.step(jnp.array([3, 0, 0]))
+    with pytest.raises(InvalidActionError, match="action 3 is out of range"):
+        envs.close()
+
+
+def test_a_bad_action_holds_no_key_and_good_rows_play_on(make_envs):
+    envs = make_envs("jax")
+    envs.reset(seed=0)
+    _, reward, *_ = envs.step(jnp.array([2, 7, 1]))
+    assert list(np.asarray(reward)) == [8.0, 0.0, 4.0]
+    with pytest.raises(InvalidActionError):
+        envs.close()
+
+
+def test_the_report_counts_and_keeps_the_first_bad_action():
+    report = jnp.asarray((0, -1, 0), jnp.int32)
+    report = accumulate(report, jnp.array([0, 1, 2]), 3)
+    assert list(np.asarray(report)) == [0, 0, 0]
+    report = accumulate(report, jnp.array([0, 4, -1]), 3)
+    assert list(np.asarray(report)) == [2, 1, 4]
+    report = accumulate(report, jnp.array([9, 0, 0]), 3)
+    assert list(np.asarray(report)) == [3, 1, 4]  # the first one stays the one named
+
+
+class _Unfinished(np.ndarray):
+    """A report the device has not finished yet."""
+
+    def is_ready(self):
+        return False
+
+
+def test_a_host_far_ahead_of_the_device_waits_for_the_oldest_report():
+    check = DeferredCheck("Game", 3, jax.devices()[0])
+    clean = np.array([0, -1, 0], np.int32)
+    for _ in range(MAX_PENDING + 5):
+        check.record(clean.view(_Unfinished), values_unchecked=True)
+        check.poll()
+    assert len(check._pending) == MAX_PENDING
+    check.poll(wait=True)  # close(): everything is read
+    assert not check._pending
+    check.record(np.array([1, 2, 7], np.int32).view(_Unfinished), values_unchecked=True)
+    with pytest.raises(InvalidActionError, match=r"action 7 is out of range; valid actions are 0\.\.2 \(env 2"):
+        check.poll(wait=True)
