@@ -28,6 +28,7 @@ from tqdm import tqdm
 
 import octax_gym
 from octax_core.env.games import list_games
+from octax_core.validate import check_int
 from octax_gym import render
 
 VIDEO_EXTRA_HINT = "pip install 'octax-gym[video]'"
@@ -221,8 +222,8 @@ def record(game: str, out: Union[str, os.PathLike], *, steps: int, policy: Polic
         ImportError: the `video` extra is missing (checked before any emulation).
     """
     gym_id = resolve_env_id(game)
-    _check_count("steps", steps)
-    _check_count("num_envs", num_envs)
+    check_int("steps", steps)
+    check_int("num_envs", num_envs)
     _check_policy(policy)
     path = _check_mp4_path(out)
     _ffmpeg_exe()  # fail before minutes of compiling and playing, not after
@@ -288,7 +289,3 @@ def _check_policy(policy: Policy) -> None:
 def _make_policy(policy: Policy, envs: gymnasium.vector.VectorEnv, seed: int) -> Callable[[Any], Any]:
     return policy if callable(policy) else POLICIES[policy](envs, seed)
 
-
-def _check_count(name: str, value) -> None:
-    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 1:
-        raise ValueError(f"{name} must be an int >= 1, got {value!r}")

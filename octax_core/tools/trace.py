@@ -26,6 +26,7 @@ import numpy as np
 
 from octax_core.env.environment import Env, EnvParams, make
 from octax_core.env.games import GameSpec, get_spec
+from octax_core.validate import check_int
 from octax_core.emulator.rom import Rom
 
 POLICIES = ("random", "noop")
@@ -144,14 +145,12 @@ def record_trace(game: str | GameSpec, *, steps: int, num_envs: int = 8, policy:
 
 
 def _check_args(steps, num_envs, policy, stall_steps) -> None:
-    for name, value in (("steps", steps), ("num_envs", num_envs)):
-        if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 1:
-            raise ValueError(f"{name} must be an int >= 1, got {value!r}")
+    check_int("steps", steps)
+    check_int("num_envs", num_envs)
     if policy not in POLICIES:
         raise ValueError(f"unknown policy {policy!r}; valid: {', '.join(POLICIES)}")
-    if stall_steps is not None and (isinstance(stall_steps, bool) or not isinstance(stall_steps, int)
-                                    or stall_steps < 0):
-        raise ValueError(f"stall_steps must be an int >= 0 (0: off), got {stall_steps!r}")
+    if stall_steps is not None:
+        check_int("stall_steps", stall_steps, minimum=0)
 
 
 @functools.lru_cache(maxsize=16)
