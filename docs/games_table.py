@@ -1,6 +1,6 @@
 """Prints the games table of docs/games.md from the registry: `python docs/games_table.py`.
 
-tests/games/test_all_games.py checks that docs/games.md holds exactly this output.
+tests/core_games/test_all_games.py checks that docs/games.md holds exactly this output.
 """
 
 import octax_core
