@@ -29,7 +29,7 @@ from typing import Optional
 import octax_side
 from harness import (DEFAULT_ROM_DIR, BenchError, Progress, bench_line, find_rom, load_average, machine_line,
                      time_interleaved)
-from throughput import GAME, our_action, prepare_env, prepare_gym, prepare_machine
+from throughput import GAME, prepare_env, prepare_gym, prepare_machine
 
 LAYERS = ("env", "gym")
 

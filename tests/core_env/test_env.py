@@ -3,7 +3,6 @@ is worked by hand: holding key 1 for a 4-frame step scores 4, the game is over w
 """
 
 import jax
-import jax.numpy as jnp
 import numpy as np
 import pytest
 

@@ -175,3 +175,23 @@ def test_only_bench_takes_arguments_it_does_not_declare(capsys):
     with pytest.raises(SystemExit) as exc:
         cli.main(["list", "--envs", "2"])
     assert exc.value.code == 2 and "unrecognized arguments: --envs 2" in capsys.readouterr().err
+
+
+def test_env_loop_prints_one_line_per_case_against_the_machine_and_octax():
+    result = subprocess.run(
+        [sys.executable, "benchmarks/env_loop.py", "--envs", "2", "--steps", "2", "--repeats", "1",
+         "--noop-max", "0,3", "--layers", "env,gym", "--max-episode-steps", "1"],
+        capture_output=True, text=True, timeout=300, cwd=REPO, check=False)
+    assert result.returncode == 0, result.stderr
+    lines = harness.parse_bench_lines(result.stdout, "env_loop")
+    assert [(line["layer"], line["noop_max"]) for line in lines] == [("env", "0"), ("env", "3"), ("gym", "0"), ("gym", "3")]
+    for line in lines:
+        assert (line["autoreset"], line["sticky"], line["max_episode_steps"]) == ("1", "0.25", "1")
+        assert float(line["vs_machine"]) == pytest.approx(int(line["sps"]) / int(line["machine_sps"]), abs=0.002)
+        assert int(line["octax_sps"]) > 0 and float(line["ratio"]) > 0
+
+
+def test_env_loop_usage_errors():
+    result = subprocess.run([sys.executable, "benchmarks/env_loop.py", "--layers", "atari"],
+                            capture_output=True, text=True, timeout=300, cwd=REPO, check=False)
+    assert result.returncode == 2 and "--layers takes env, gym" in result.stderr
