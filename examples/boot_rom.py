@@ -1,6 +1,6 @@
 """Boot a CHIP-8 ROM, run it for one second (60 frames) and print its screen; then run a batch of 4.
 
-    python examples/boot_rom.py [ROM]     # default: the IBM logo from the test suite in ../shared
+    python examples/boot_rom.py [ROM]     # default: our own Dodge (roms/dodge.ch8), its start screen
 """
 
 import sys
@@ -11,7 +11,7 @@ import numpy as np
 
 import octax_core
 
-DEFAULT_ROM = Path(__file__).resolve().parents[1] / "../shared/roms/test-suite/2-ibm-logo.ch8"
+DEFAULT_ROM = Path(__file__).resolve().parents[1] / "roms" / "dodge.ch8"
 
 rom = Path(sys.argv[1]) if len(sys.argv) > 1 else DEFAULT_ROM
 machine = octax_core.Machine(quirks="chip8", instructions_per_frame=11)
