@@ -34,7 +34,7 @@ so the first rocks' columns are drawn from each episode's reset key. Episodes ar
 steps (5 minutes).
 """
 
-from octax_core.env.games.spec import GameSpec, key_mask, register_value
+from octax_core.env.games._own import level_specs, own_game_spec
 
 _LEVELS = (  # level: rocks, pixels per fall
     (1, 2, 1),
@@ -44,19 +44,13 @@ _LEVELS = (  # level: rocks, pixels per fall
 DEFAULT_LEVEL = 2
 
 
-def _spec(game_id: str, level: int, rocks: int, fall: int) -> GameSpec:
-    return GameSpec(
-        id=game_id,
+def _spec(game_id: str, level: int, rocks: int, fall: int):
+    return own_game_spec(
+        game_id, level,
         title=f"Dodge, level {level} ({rocks} rocks, {fall} pixel{'s' if fall > 1 else ''} per move)",
         rom_file="dodge.ch8",
         rom_sha1="b18d01a319230c9d99c24a19c46bef6c81464269",
         action_keys=(4, 6),
-        score_fn=lambda state: register_value(state, 5),
-        terminated_fn=lambda state: state.V[14] == 1,
-        lives_fn=lambda state: register_value(state, 6),
-        startup=((0, 10), (key_mask(level), 3), (0, 25)),
-        quirks="chip8",
-        max_episode_steps=4500,
         category="reaction",
         description=f"Move the ship (keys 4 left, 6 right) to dodge {rocks} falling rocks; reward +1 "
                     "per rock that lands beside the ship; the game ends when 3 rocks have hit it "
@@ -64,6 +58,4 @@ def _spec(game_id: str, level: int, rocks: int, fall: int) -> GameSpec:
     )
 
 
-SPECS = tuple(_spec(f"Dodge{level}", level, rocks, fall) for level, rocks, fall in _LEVELS) + (
-    _spec("Dodge", *_LEVELS[DEFAULT_LEVEL - 1]),
-)
+SPECS = level_specs("Dodge", _LEVELS, DEFAULT_LEVEL, _spec)

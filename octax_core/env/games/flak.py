@@ -38,7 +38,7 @@ inside the pause, so the first planes are drawn from each episode's reset key. E
 cut at 4,500 steps (5 minutes).
 """
 
-from octax_core.env.games.spec import GameSpec, key_mask, register_value
+from octax_core.env.games._own import level_specs, own_game_spec
 
 _LEVELS = (  # level: planes, pixels per move
     (1, 1, 1),
@@ -48,20 +48,14 @@ _LEVELS = (  # level: planes, pixels per move
 DEFAULT_LEVEL = 2
 
 
-def _spec(game_id: str, level: int, planes: int, speed: int) -> GameSpec:
-    return GameSpec(
-        id=game_id,
+def _spec(game_id: str, level: int, planes: int, speed: int):
+    return own_game_spec(
+        game_id, level,
         title=f"Flak, level {level} ({planes} plane{'s' if planes > 1 else ''}, "
               f"{speed} pixel{'s' if speed > 1 else ''} per move)",
         rom_file="flak.ch8",
         rom_sha1="7bb42d4abb5f4ed443fc767a67689a7b96e66430",
         action_keys=(4, 6, 5),
-        score_fn=lambda state: register_value(state, 5),
-        terminated_fn=lambda state: state.V[14] == 1,
-        lives_fn=lambda state: register_value(state, 6),
-        startup=((0, 10), (key_mask(level), 3), (0, 25)),
-        quirks="chip8",
-        max_episode_steps=4500,
         category="timing",
         description="Move the gun (keys 4 left, 6 right) and fire (key 5) at the planes crossing "
                     "the sky; reward +1 per plane shot down; the game ends when 3 planes have "
@@ -69,6 +63,4 @@ def _spec(game_id: str, level: int, planes: int, speed: int) -> GameSpec:
     )
 
 
-SPECS = tuple(_spec(f"Flak{level}", level, planes, speed) for level, planes, speed in _LEVELS) + (
-    _spec("Flak", *_LEVELS[DEFAULT_LEVEL - 1]),
-)
+SPECS = level_specs("Flak", _LEVELS, DEFAULT_LEVEL, _spec)

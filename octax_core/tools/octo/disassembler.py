@@ -18,80 +18,10 @@ That is why a few choices look fussy:
 from __future__ import annotations
 
 import dataclasses
-import enum
 
+from octax_core.emulator.opcodes import Flow, lookup
 from octax_core.emulator.rom import MAX_ROM_SIZE, PROGRAM_ADDRESS, Rom, RomLike
 
-
-class Flow(enum.Enum):
-    """Where execution may go after an instruction, and what its address operand points at."""
-
-    NEXT = enum.auto()  # the next instruction
-    STOP = enum.auto()  # nowhere we can follow: return, exit
-    JUMP = enum.auto()  # the target only
-    CALL = enum.auto()  # the target, then the next instruction
-    SKIP = enum.auto()  # the next instruction or the one after it
-    JUMP0 = enum.auto()  # target + v0: unknown, so the path ends; the target still gets a label
-    INDEX = enum.auto()  # the next instruction; the target is data (i := target)
-
-
-# (mask, pattern, Octo statement, flow): the first row whose `word & mask == pattern` decodes the
-# word. Fields: {x} {y} as registers, {xn} {n} as numbers, {nn} {nnn} in hex, {target} a label or
-# an address. Rows are data so that adding an opcode is one line (style guide, section 3).
-_OPCODES = (
-    (0xFFFF, 0x00E0, "clear", Flow.NEXT),
-    (0xFFFF, 0x00EE, "return", Flow.STOP),
-    (0xFFF0, 0x00C0, "scroll-down {n}", Flow.NEXT),
-    (0xFFF0, 0x00D0, "scroll-up {n}", Flow.NEXT),
-    (0xFFFF, 0x00FB, "scroll-right", Flow.NEXT),
-    (0xFFFF, 0x00FC, "scroll-left", Flow.NEXT),
-    (0xFFFF, 0x00FD, "exit", Flow.STOP),
-    (0xFFFF, 0x00FE, "lores", Flow.NEXT),
-    (0xFFFF, 0x00FF, "hires", Flow.NEXT),
-    (0xFFFF, 0x0000, None, None),  # 0000 is padding far more often than a machine-code call
-    (0xF000, 0x0000, "native {nnn}", Flow.NEXT),
-    (0xF000, 0x1000, "jump {target}", Flow.JUMP),
-    (0xF000, 0x2000, "{target}", Flow.CALL),  # a bare label name is a call in Octo
-    (0xF000, 0x3000, "if {x} != {nn} then", Flow.SKIP),  # `if C then S` skips S when C is false
-    (0xF000, 0x4000, "if {x} == {nn} then", Flow.SKIP),
-    (0xF00F, 0x5000, "if {x} != {y} then", Flow.SKIP),
-    (0xF00F, 0x5002, "save {x} - {y}", Flow.NEXT),
-    (0xF00F, 0x5003, "load {x} - {y}", Flow.NEXT),
-    (0xF000, 0x6000, "{x} := {nn}", Flow.NEXT),
-    (0xF000, 0x7000, "{x} += {nn}", Flow.NEXT),
-    (0xF00F, 0x8000, "{x} := {y}", Flow.NEXT),
-    (0xF00F, 0x8001, "{x} |= {y}", Flow.NEXT),
-    (0xF00F, 0x8002, "{x} &= {y}", Flow.NEXT),
-    (0xF00F, 0x8003, "{x} ^= {y}", Flow.NEXT),
-    (0xF00F, 0x8004, "{x} += {y}", Flow.NEXT),
-    (0xF00F, 0x8005, "{x} -= {y}", Flow.NEXT),
-    (0xF00F, 0x8006, "{x} >>= {y}", Flow.NEXT),
-    (0xF00F, 0x8007, "{x} =- {y}", Flow.NEXT),
-    (0xF00F, 0x800E, "{x} <<= {y}", Flow.NEXT),
-    (0xF00F, 0x9000, "if {x} == {y} then", Flow.SKIP),
-    (0xF000, 0xA000, "i := {target}", Flow.INDEX),
-    (0xF000, 0xB000, "jump0 {target}", Flow.JUMP0),
-    (0xF000, 0xC000, "{x} := random {nn}", Flow.NEXT),
-    (0xF000, 0xD000, "sprite {x} {y} {n}", Flow.NEXT),
-    (0xF0FF, 0xE09E, "if {x} -key then", Flow.SKIP),
-    (0xF0FF, 0xE0A1, "if {x} key then", Flow.SKIP),
-    (0xFFFF, 0xF000, "i := long {target}", Flow.INDEX),  # XO-CHIP: the address is the next word
-    (0xFCFF, 0xF001, "plane {xn}", Flow.NEXT),  # Octo takes plane masks 0-3 only
-    (0xFFFF, 0xF002, "audio", Flow.NEXT),
-    (0xF0FF, 0xF007, "{x} := delay", Flow.NEXT),
-    (0xF0FF, 0xF00A, "{x} := key", Flow.NEXT),
-    (0xF0FF, 0xF015, "delay := {x}", Flow.NEXT),
-    (0xF0FF, 0xF018, "buzzer := {x}", Flow.NEXT),
-    (0xF0FF, 0xF01E, "i += {x}", Flow.NEXT),
-    (0xF0FF, 0xF029, "i := hex {x}", Flow.NEXT),
-    (0xF0FF, 0xF030, "i := bighex {x}", Flow.NEXT),
-    (0xF0FF, 0xF033, "bcd {x}", Flow.NEXT),
-    (0xF0FF, 0xF03A, "pitch := {x}", Flow.NEXT),
-    (0xF0FF, 0xF055, "save {x}", Flow.NEXT),
-    (0xF0FF, 0xF065, "load {x}", Flow.NEXT),
-    (0xF8FF, 0xF075, "saveflags {x}", Flow.NEXT),  # Octo's flags registers are v0-v7
-    (0xF8FF, 0xF085, "loadflags {x}", Flow.NEXT),
-)
 
 _LABEL_PREFIX = {Flow.CALL: "sub", Flow.JUMP: "loc", Flow.JUMP0: "table", Flow.INDEX: "data"}
 _PICTURE_MAX = 32  # data runs up to this long (a 16x16 sprite) are drawn one byte a line
@@ -146,10 +76,10 @@ def decode(rom: bytes, address: int) -> Instruction | None:
     if offset < 0 or offset + 2 > len(rom):
         return None
     word = rom[offset] << 8 | rom[offset + 1]
-    row = next((row for row in _OPCODES if word & row[0] == row[1]), None)
-    if row is None or row[2] is None:
+    row = lookup(word)  # the opcode table the emulator decodes with too
+    if row is None or row.octo is None:
         return None
-    _, _, template, flow = row
+    template, flow = row.octo, row.flow
     x, y = word >> 8 & 0xF, word >> 4 & 0xF
     fields = {"x": f"v{x:x}", "y": f"v{y:x}", "xn": x, "n": word & 0xF, "nn": f"0x{word & 0xFF:02X}",
               "nnn": f"0x{word & 0xFFF:03X}"}
