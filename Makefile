@@ -16,7 +16,9 @@ PIP    := $(PY) -m pip
 TORCH        := torch==2.13.0
 TORCH_EXTRAS := torch sb3 torchrl all
 
-# Third-party ROMs are never committed: tests and benchmarks read them from ../shared.
+# Third-party ROMs are never committed. Tests and benchmarks read the octax suite's ROMs from
+# ../shared when it is there; on any other machine `roms-ready` fetches them from PyPI, once,
+# into the user data folder (hash-verified by the ROM store), where the store finds them.
 export OCTAX_ROM_DIR ?= ../shared/roms/octax
 
 # Two pytest workers: JAX compiles are CPU-bound and mostly single-threaded, and on 2 cores this cut
@@ -25,18 +27,25 @@ export OCTAX_ROM_DIR ?= ../shared/roms/octax
 PYTEST_ARGS ?= -n 2 --dist loadfile
 BENCH_ARGS  ?=
 
+# Every game's ROM present and verified, or the octax wheel's ROMs installed from PyPI: no network
+# when they are all there already (a hash check of a few dozen small files).
+ROMS_READY := $(PY) -m octax_gym roms install --if-missing
+
 .PHONY: help demo test bench roms clean
 
 help:
 	@sed -n 's/^# \(make .*\)/\1/p' Makefile
 
 demo: $(VENV)/.installed-video
+	$(ROMS_READY)
 	$(PY) -m octax_gym.demo
 
 test: $(VENV)/.installed-all
+	$(ROMS_READY)
 	$(PY) -m pytest $(PYTEST_ARGS)
 
 bench: $(VENV)/.installed-dev
+	$(ROMS_READY)
 	$(PY) benchmarks/throughput.py $(BENCH_ARGS)
 
 # tests/core/test_own_roms.py checks that the committed ROMs are what this builds; a game's

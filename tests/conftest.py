@@ -1,7 +1,8 @@
 """Shared fixtures: where the ROMs are, and jitted machine functions compiled once per session.
 
 JAX compiles are the slow part of this suite, so every test that runs a `Machine` goes through
-these caches: one compile per (machine config, function) for the whole session.
+these caches: one compile per (machine config, function) for the whole session. Where the
+third-party data comes from, and what happens without ../shared: tests/shared_data.py.
 """
 
 from __future__ import annotations
@@ -15,12 +16,21 @@ import pytest
 
 import octax_core
 
-REPO = Path(__file__).resolve().parents[1]
-SHARED = REPO.parent / "shared"
-TEST_SUITE_DIR = SHARED / "roms" / "test-suite"
-# Tests read the third-party ROMs from ../shared (never from git); `make test` sets this too.
+from shared_data import REQUIRE_SHARED, SHARED, TEST_SUITE_DIR, missing_shared, octax_rom_folder
+
+# Tests read the octax suite's ROMs from ../shared when it is there (never from git), else from
+# the user data folder that `octax-gym roms install` fills; `make test` sets this too.
 os.environ.setdefault("OCTAX_ROM_DIR", str(SHARED / "roms" / "octax"))
-OCTAX_ROM_DIR = Path(os.environ["OCTAX_ROM_DIR"]).resolve()
+
+
+def pytest_runtest_setup(item):
+    """Tests marked `shared` need ../shared: skipped without it, failed if it is required."""
+    if item.get_closest_marker("shared") is not None:
+        why = missing_shared(SHARED)
+        if why is not None:
+            if REQUIRE_SHARED:
+                pytest.fail(f"{why} (OCTAX_REQUIRE_SHARED=1: this run must have it)")
+            pytest.skip(why)
 
 
 @functools.lru_cache(maxsize=None)
@@ -61,13 +71,21 @@ def counter_rom(tmp_path_factory) -> Path:
 
 @pytest.fixture(scope="session")
 def test_suite_dir() -> Path:
-    if not TEST_SUITE_DIR.is_dir():
-        pytest.fail(f"the CHIP-8 test suite is missing: expected {TEST_SUITE_DIR} (../shared beside the repo)")
+    """The Timendus test suite in ../shared (tests using it are marked `shared` too)."""
+    why = missing_shared(TEST_SUITE_DIR)
+    if why is not None:
+        if REQUIRE_SHARED:
+            pytest.fail(why)
+        pytest.skip(why)
     return TEST_SUITE_DIR
 
 
 @pytest.fixture(scope="session")
 def octax_rom_dir() -> Path:
-    if not OCTAX_ROM_DIR.is_dir():
-        pytest.fail(f"game ROMs missing: expected {OCTAX_ROM_DIR}; set OCTAX_ROM_DIR=../shared/roms/octax")
-    return OCTAX_ROM_DIR
+    """The folder with every third-party game's ROM (OCTAX_ROM_DIR, or the user data folder)."""
+    folder = octax_rom_folder()
+    if folder is None:
+        pytest.fail("the octax suite's ROMs are missing: neither OCTAX_ROM_DIR "
+                    f"({os.environ.get('OCTAX_ROM_DIR')}) nor the user data folder holds them all; "
+                    "run `octax-gym roms install` (make test does)")
+    return folder

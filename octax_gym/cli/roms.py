@@ -27,6 +27,9 @@ def add_commands(commands: argparse._SubParsersAction) -> None:
     install = sub.add_parser("install", help=f"download the octax=={OCTAX_VERSION} wheel with pip and "
                                              "install the ROMs whose hashes match")
     install.add_argument("--dest", type=Path, help="target folder (default: the user data folder)")
+    install.add_argument("--if-missing", action="store_true",
+                         help="download only if some game has no verified ROM in the folders searched "
+                              "(what `make demo` and `make test` run: no network when all are there)")
     install.set_defaults(func=_cmd_roms_install)
     imp = sub.add_parser("import", help="install matching ROMs from a folder, zip or wheel on disk")
     imp.add_argument("path", type=Path, help="folder (searched recursively), .zip or .whl")
@@ -59,6 +62,13 @@ def _cmd_roms_install(args: argparse.Namespace) -> int:
     from octax_core.env import romstore
 
     specs = game_specs()
+    if args.if_missing:
+        missing = [row.game_id for row in romstore.rom_status(specs) if not row.verified]
+        if not missing:
+            print(f"every game ({len(specs)}) has its verified ROM already; nothing to download. Searched: "
+                  + ", ".join(str(d) for d in romstore.search_dirs()))
+            return 0
+        print(f"{len(missing)} game(s) without a verified ROM: {', '.join(missing)}")
     print(f"downloading octax=={OCTAX_VERSION} with pip ...")
     results = romstore.install_from_pypi(specs, args.dest, OCTAX_VERSION)
     return _report_import(results, specs, args.dest)
@@ -72,7 +82,11 @@ def _cmd_roms_import(args: argparse.Namespace) -> int:
 
 
 def _report_import(results: list, specs: list, dest: Optional[Path]) -> int:
-    """Prints what was installed and which games still lack a ROM; 1 if nothing matched."""
+    """Prints what was installed and which games still lack a ROM; 1 if nothing matched.
+
+    A game counts as missing only if no folder searched has its ROM either: our own games (built
+    from roms/*.8o) are never in the octax wheel, and are not missing when roms/ has them.
+    """
     from octax_core.env import romstore
 
     if not specs:
@@ -82,6 +96,7 @@ def _report_import(results: list, specs: list, dest: Optional[Path]) -> int:
         print(f"{r.action:9}  {r.rom_file}  ({', '.join(r.game_ids)})")
     dest = (dest if dest is not None else romstore.user_rom_dir()).expanduser().resolve()
     covered = {game_id for r in results for game_id in r.game_ids}
+    covered |= {row.game_id for row in romstore.rom_status(specs) if row.verified}
     missing = [spec.id for spec in specs if spec.id not in covered]
     print(f"{len(results)} ROM files in {dest}"
           + (f"; no matching ROM for: {', '.join(missing)}" if missing else "; every game has its ROM"))

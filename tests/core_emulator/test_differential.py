@@ -1,4 +1,5 @@
-"""Differential test: the JAX core against tests/reference.py, frame by frame, on every shared ROM.
+"""Differential test: the JAX core against tests/reference.py, frame by frame, on every ROM we have:
+the octax suite's (from ../shared, or the ROM store), our own, and the test suite (../shared only).
 
 Each ROM boots under both profiles, the reference takes the core's boot rng, and both run the
 same scripted keys (stretches of nothing, single keys and random masks, changing every few
@@ -7,20 +8,20 @@ every frame. On a mismatch the failing frame is replayed one instruction at a ti
 first instruction that differs.
 """
 
-import os
 import random
 import zlib
-from pathlib import Path
 
 import jax
 import pytest
 from reference import RefMachine, first_difference
+from shared_data import REPO, TEST_SUITE_DIR, octax_rom_folder
 
 import octax_core
 
-SHARED = Path(__file__).resolve().parents[3] / "shared"  # ../shared beside the repo
-ROM_DIRS = (Path(os.environ.get("OCTAX_ROM_DIR", SHARED / "roms" / "octax")), SHARED / "roms" / "test-suite")
-ROMS = sorted(path for directory in ROM_DIRS for path in directory.glob("*.ch8"))
+OCTAX_ROMS = octax_rom_folder()
+ROMS = ([pytest.param(path, id=path.stem[:24]) for path in sorted(OCTAX_ROMS.glob("*.ch8"))] if OCTAX_ROMS else []) + [
+    pytest.param(path, id=path.stem[:24]) for path in sorted((REPO / "roms").glob("*.ch8"))] + [
+    pytest.param(path, id=path.stem[:24], marks=pytest.mark.shared) for path in sorted(TEST_SUITE_DIR.glob("*.ch8"))]
 PROFILES = ("chip8", "schip")
 FRAMES = 240
 INSTRUCTIONS_PER_FRAME = 11
@@ -56,13 +57,18 @@ def localize(execute, machine, state, ref, keys):
     return "all instructions of the frame agree: the difference is in the timer tick or the frame length"
 
 
-def test_rom_dirs_found():
-    for directory in ROM_DIRS:
-        assert any(directory.glob("*.ch8")), f"no ROMs in {directory}"
+def test_the_octax_roms_are_found():
+    assert OCTAX_ROMS is not None, "no folder holds the octax suite's ROMs: run `octax-gym roms install`"
+    assert len(list(OCTAX_ROMS.glob("*.ch8"))) >= 30
+
+
+@pytest.mark.shared
+def test_the_test_suite_is_found():
+    assert len(list(TEST_SUITE_DIR.glob("*.ch8"))) >= 9
 
 
 @pytest.mark.parametrize("profile", PROFILES)
-@pytest.mark.parametrize("rom_path", ROMS, ids=[path.stem[:24] for path in ROMS])
+@pytest.mark.parametrize("rom_path", ROMS)
 def test_core_matches_reference(rom_path, profile, jit_run_frames, jit_execute):
     rom = rom_path.read_bytes()
     seed = zlib.crc32(rom_path.name.encode())

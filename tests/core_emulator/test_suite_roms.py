@@ -22,6 +22,7 @@ from screen_text import CORAX_NO, CORAX_OK, FLAG_ERR, FLAG_OK
 import octax_core
 
 SUITE = st.SUITE
+pytestmark = pytest.mark.shared  # the Timendus test suite is only in ../shared
 SECOND = 60  # frames
 IPF = 11
 

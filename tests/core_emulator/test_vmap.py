@@ -15,14 +15,15 @@ import jax.numpy as jnp
 import numpy as np
 import pytest
 from reference import first_difference
+from shared_data import TEST_SUITE_DIR, octax_rom_folder
 
 import octax_core
 
-SHARED = Path(__file__).resolve().parents[3] / "shared"
+OCTAX_ROMS = octax_rom_folder() or Path("no-octax-roms")  # the octax suite, from ../shared or the ROM store
 CASES = [
-    (SHARED / "roms" / "octax" / "Brix [Andreas Gustafsson, 1990].ch8", "chip8"),
-    (SHARED / "roms" / "octax" / "Tetris [Fran Dachille, 1991].ch8", "schip"),
-    (SHARED / "roms" / "test-suite" / "6-keypad.ch8", "chip8"),
+    pytest.param(OCTAX_ROMS / "Brix [Andreas Gustafsson, 1990].ch8", "chip8", id="Brix"),
+    pytest.param(OCTAX_ROMS / "Tetris [Fran Dachille, 1991].ch8", "schip", id="Tetris"),
+    pytest.param(TEST_SUITE_DIR / "6-keypad.ch8", "chip8", id="6-keypad", marks=pytest.mark.shared),
 ]
 BATCH = 8
 FRAMES_PER_CALL = 10
@@ -55,7 +56,7 @@ def as_bools(masks):
     return jnp.asarray([[bool((mask >> k) & 1) for k in range(16)] for mask in masks])
 
 
-@pytest.mark.parametrize("rom_path, profile", CASES, ids=[path.stem[:12] for path, _ in CASES])
+@pytest.mark.parametrize("rom_path, profile", CASES)
 def test_batched_equals_single(rom_path, profile, jit_run_frames):
     rom = rom_path.read_bytes()
     machine = octax_core.Machine(quirks=profile, instructions_per_frame=11)
@@ -83,7 +84,7 @@ def test_batched_equals_single(rom_path, profile, jit_run_frames):
 
 
 def test_vmapped_boot_equals_single_boots():
-    rom_path, profile = CASES[0]
+    rom_path, profile = CASES[0].values
     rom = rom_path.read_bytes()
     machine = octax_core.Machine(quirks=profile)
     boot_keys = jax.random.split(jax.random.key(3), BATCH)

@@ -8,6 +8,7 @@ import zipfile
 from pathlib import Path
 
 import pytest
+from shared_data import SHARED
 from fake_games import make_spec, read_sha1sums, sha1, specs_from_sha1sums
 
 from octax_core import Rom
@@ -18,6 +19,7 @@ from octax_core.env.romstore import RomHashError, RomInstallError, RomNotFoundEr
 PONG = b"\x00\xe0\x12\x00pong"
 BRIX = b"\x00\xe0\x12\x00brix"
 OTHER = b"\x00\xe0\x12\x00not a game of ours"
+SHARED_OCTAX = SHARED / "roms" / "octax"
 REAL_PROJECT_ROM_DIR = romstore.PROJECT_ROM_DIR  # before the autouse fixture swaps it
 # The games whose ROMs are third-party, in the shared store; ours are built in roms/ (test_own_roms.py).
 THIRD_PARTY_GAMES = [g for g in list_games() if not (REAL_PROJECT_ROM_DIR / get_spec(g).rom_file).is_file()]
@@ -261,7 +263,9 @@ def test_install_from_pypi_failures_are_clear(monkeypatch, pong, kind, match):
 
 # --- the real ROMs ---------------------------------------------------------------------------
 
-def test_shared_roms_import_cleanly_by_hash(octax_rom_dir, tmp_path):
+@pytest.mark.shared
+def test_shared_roms_import_cleanly_by_hash(tmp_path):
+    octax_rom_dir = SHARED_OCTAX  # with its SHA1SUMS manifest
     specs = specs_from_sha1sums(octax_rom_dir / "SHA1SUMS") + [get_spec(i) for i in THIRD_PARTY_GAMES]
     specs = list({(s.id, s.rom_file): s for s in specs}.values())
     results = romstore.import_roms(octax_rom_dir, specs, dest=tmp_path / "dest")
@@ -270,7 +274,9 @@ def test_shared_roms_import_cleanly_by_hash(octax_rom_dir, tmp_path):
         assert romstore.find_rom(spec, tmp_path / "dest") == tmp_path / "dest" / spec.rom_file
 
 
-def test_install_from_pypi_gets_the_real_octax_wheel(octax_rom_dir, tmp_path):
+@pytest.mark.shared
+def test_install_from_pypi_gets_the_real_octax_wheel(tmp_path):
+    octax_rom_dir = SHARED_OCTAX  # with its SHA1SUMS manifest
     manifest = read_sha1sums(octax_rom_dir / "SHA1SUMS")
     specs = specs_from_sha1sums(octax_rom_dir / "SHA1SUMS")
     try:
@@ -281,8 +287,10 @@ def test_install_from_pypi_gets_the_real_octax_wheel(octax_rom_dir, tmp_path):
     assert installed == {name: digest for name, digest in manifest.items() if name.endswith(".ch8")}
 
 
+@pytest.mark.shared
 @pytest.mark.parametrize("game_id", THIRD_PARTY_GAMES)
-def test_registered_game_rom_is_in_the_shared_store(game_id, octax_rom_dir, monkeypatch):
+def test_registered_game_rom_is_in_the_shared_store(game_id, monkeypatch):
+    octax_rom_dir = SHARED_OCTAX  # with its SHA1SUMS manifest
     spec = get_spec(game_id)
     assert read_sha1sums(octax_rom_dir / "SHA1SUMS").get(spec.rom_file) == spec.rom_sha1.lower()
     monkeypatch.setenv("OCTAX_ROM_DIR", str(octax_rom_dir))

@@ -3,19 +3,18 @@ compile-time language (macros, string modes, :calc), and errors that carry line 
 
 from __future__ import annotations
 
-import os
 from pathlib import Path
 
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from shared_data import SHARED, TEST_SUITE_DIR
+
 from octax_core import AssemblyError, assemble
 from octax_core.tools.octo import assemble_program
 
-SHARED = Path(__file__).resolve().parents[3] / "shared"  # ../shared beside the repo
-OCTAX_ROM_DIR = Path(os.environ.get("OCTAX_ROM_DIR", SHARED / "roms" / "octax"))
-TEST_SUITE_DIR = SHARED / "roms" / "test-suite"
+OCTAX_ROM_DIR = SHARED / "roms" / "octax"  # the Octo sources are only there, not in the ROM store
 
 SOURCES = sorted(OCTAX_ROM_DIR.glob("*.8o")) + sorted(TEST_SUITE_DIR.glob("*.8o"))
 
@@ -26,11 +25,13 @@ def _reference_rom(source: Path) -> Path:
     return same_name if same_name.exists() else source.with_name(source.stem + "1.ch8")
 
 
+@pytest.mark.shared
 def test_every_shared_source_is_found():
     # 7 octax sources and 9 test-suite sources: a missing folder must fail, not pass vacuously.
     assert len(SOURCES) == 16, [s.name for s in SOURCES]
 
 
+@pytest.mark.shared
 @pytest.mark.parametrize("source", SOURCES, ids=lambda p: p.name)
 def test_shared_sources_assemble_byte_exact(source):
     expected = _reference_rom(source).read_bytes()

@@ -7,20 +7,18 @@ code-heavy programs whose jumps land anywhere, odd addresses and mid-instruction
 
 from __future__ import annotations
 
-import os
-from pathlib import Path
 
 import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
+from shared_data import SHARED, TEST_SUITE_DIR
+
 from octax_core import MAX_ROM_SIZE, Rom
 from octax_core.tools.octo import assemble
 from octax_core.tools.octo.disassembler import decode, disassemble
 
-SHARED = Path(__file__).resolve().parents[3] / "shared"  # ../shared beside the repo
-OCTAX_ROM_DIR = Path(os.environ.get("OCTAX_ROM_DIR", SHARED / "roms" / "octax"))
-TEST_SUITE_DIR = SHARED / "roms" / "test-suite"
+OCTAX_ROM_DIR = SHARED / "roms" / "octax"  # every file there, not only the games' ROMs
 ROMS = sorted(OCTAX_ROM_DIR.glob("*.ch8")) + sorted(TEST_SUITE_DIR.glob("*.ch8"))
 START = 0x200
 # (opcode, mask of its free bits): the skips, the shifts and XO-CHIP's register-range save
@@ -41,12 +39,14 @@ def body_lines(source: str) -> list[str]:
     return [line for line in lines if line]
 
 
+@pytest.mark.shared
 def test_every_shared_rom_is_found():
     # a missing ../shared must fail, not pass vacuously
     assert len([p for p in ROMS if p.parent == TEST_SUITE_DIR]) >= 9
     assert len([p for p in ROMS if p.parent == OCTAX_ROM_DIR]) >= 30
 
 
+@pytest.mark.shared
 @pytest.mark.parametrize("path", ROMS, ids=lambda p: p.name)
 def test_shared_roms_round_trip(path):
     round_trips(path.read_bytes())

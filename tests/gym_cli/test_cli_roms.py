@@ -5,6 +5,7 @@ from __future__ import annotations
 import subprocess
 import sys
 import zipfile
+from pathlib import Path
 
 import pytest
 from fake_games import make_spec
@@ -120,3 +121,44 @@ def test_roms_list_with_the_real_registry_and_shared_roms(octax_rom_dir, capsys,
     assert cli.main(["roms", "list"]) == 0
     n = len(list_games())
     assert f"{n}/{n} ROMs present and verified" in capsys.readouterr().out
+
+
+def test_install_does_not_count_our_own_games_as_missing(tmp_path, capsys, monkeypatch, fake_games):
+    """Our own games' ROMs are built in roms/, never in the octax wheel: found there, not missing."""
+    own_rom = b"\x12\x00own game"
+    own = make_spec("Own", "own.ch8", own_rom)
+    project = tmp_path / "project-roms"
+    project.mkdir()
+    (project / "own.ch8").write_bytes(own_rom)
+    monkeypatch.setattr(romstore, "PROJECT_ROM_DIR", project)
+    monkeypatch.setattr(cli_roms, "game_specs", lambda: [*fake_games, own])
+
+    def wheel_of_two(specs, dest, version):
+        target = romstore.user_rom_dir()
+        return romstore.import_roms(_folder_with(tmp_path / "wheel", {"a.ch8": BRIX, "b.ch8": PONG}), specs, target)
+    monkeypatch.setattr(romstore, "install_from_pypi", wheel_of_two)
+    assert cli.main(["roms", "install"]) == 0
+    out = capsys.readouterr().out
+    assert "every game has its ROM" in out and "Own" not in out
+
+
+def test_install_if_missing_downloads_only_when_a_rom_is_missing(tmp_path, capsys, monkeypatch, fake_games):
+    calls = []
+
+    def wheel(specs, dest, version):
+        calls.append(version)
+        return romstore.import_roms(_folder_with(tmp_path / "wheel", {"a.ch8": BRIX, "b.ch8": PONG}), specs, dest)
+    monkeypatch.setattr(romstore, "install_from_pypi", wheel)
+    assert cli.main(["roms", "install", "--if-missing"]) == 0
+    out = capsys.readouterr().out
+    assert calls == ["0.1.1"] and "2 game(s) without a verified ROM: Brix, Pong" in out
+    assert cli.main(["roms", "install", "--if-missing"]) == 0
+    assert calls == ["0.1.1"]  # all there now: no second download
+    assert "every game (2) has its verified ROM already; nothing to download" in capsys.readouterr().out
+
+
+def _folder_with(folder: Path, files: dict) -> Path:
+    folder.mkdir(parents=True, exist_ok=True)
+    for name, data in files.items():
+        (folder / name).write_bytes(data)
+    return folder
