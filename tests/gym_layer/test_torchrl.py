@@ -215,3 +215,15 @@ def test_the_example_ppo_update_runs_on_a_collector_batch(counter_rom):
     assert any(not torch.equal(a, b) for a, b in zip(before, agent.parameters()))
     returns = example.play_episodes(env, fixed_policy, seed=0)
     assert returns.tolist() == [24.0, 16.0, 0.0]
+
+
+def test_an_out_of_range_action_raises_a_named_error(counter_rom):
+    """TorchRL's actions are torch tensors: range-checked on the device, never clamped, raised later."""
+    from octax_gym import InvalidActionError
+
+    env = make(counter_rom)
+    td = env.reset()
+    with pytest.raises(InvalidActionError, match=r"action 7 .*valid actions are 0\.\.2"):
+        env.step(td.set("action", torch.tensor([2, 7, 0])))
+        env.reset()  # the error surfaces here at the latest if the step's report was not ready,
+        env.vector_env.close()  # or, the device still busy, when the env is closed
