@@ -28,3 +28,17 @@ def test_unknown_attribute_is_an_attribute_error():
         assert "make_rllib_env" in str(exc)
     else:
         raise AssertionError("expected AttributeError")
+
+
+def test_the_public_names_stay_where_users_import_them():
+    """The layout moved modules into subpackages; these top-level names must not move with them."""
+    import octax_core
+    import octax_gym
+    import octax_gym.sb3
+    import octax_gym.torchrl
+
+    for name in ("Machine", "Quirks", "make", "list_games", "get_spec", "snapshot", "poke", "assemble", "disassemble"):
+        assert callable(getattr(octax_core, name)), name
+    for name in ("OctaxEnv", "OctaxVectorEnv", "InvalidActionError", "make_sb3_vec_env", "make_torchrl_env"):
+        assert getattr(octax_gym, name) is not None, name
+    assert callable(octax_gym.sb3.make_sb3_vec_env) and callable(octax_gym.torchrl.make_torchrl_env)
