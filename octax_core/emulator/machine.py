@@ -28,7 +28,7 @@ class Machine:
     """A CHIP-8 interpreter configuration.
 
     Args:
-        quirks: a profile name ("chip8", "schip") or a `Quirks`.
+        quirks: a profile name ("chip8", "schip", "xochip"; `QUIRK_PROFILES`) or a `Quirks`.
         instructions_per_frame: instructions run per 60 Hz frame (11 is about the COSMAC VIP's
             speed on typical game code).
 

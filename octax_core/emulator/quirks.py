@@ -51,6 +51,15 @@ QUIRK_PROFILES: dict[str, Quirks] = {
         shift_uses_vy=False,
         jump_uses_vx=True,
     ),
+    # XO-CHIP as Octo runs it: FX55/FX65 advance I, sprites wrap at the edges, shifts read VY.
+    "xochip": Quirks(
+        vf_reset=False,
+        memory_increment=True,
+        display_wait=False,
+        clipping=False,
+        shift_uses_vy=True,
+        jump_uses_vx=False,
+    ),
 }
 
 

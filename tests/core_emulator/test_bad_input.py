@@ -85,9 +85,9 @@ def test_a_directory_is_not_a_rom(key, tmp_path):
         Machine("chip8").boot(tmp_path, key)
 
 
-@pytest.mark.parametrize("name", ["CHIP8", "chip-8", "xochip", "", "superchip"])
+@pytest.mark.parametrize("name", ["CHIP8", "chip-8", "xo-chip", "", "superchip"])
 def test_unknown_profile_lists_valid_ones(name):
-    with pytest.raises(ValueError, match=r"(?s)(?=.*'chip8')(?=.*'schip')") as info:
+    with pytest.raises(ValueError, match=r"(?s)(?=.*'chip8')(?=.*'schip')(?=.*'xochip')") as info:
         Machine(quirks=name)
     assert repr(name) in str(info.value)
 
@@ -98,7 +98,7 @@ def test_quirks_of_the_wrong_type():
 
 
 def test_profiles_are_the_documented_ones():
-    assert set(octax_core.QUIRK_PROFILES) == {"chip8", "schip"}
+    assert set(octax_core.QUIRK_PROFILES) == {"chip8", "schip", "xochip"}
 
 
 @pytest.mark.parametrize("ipf", [0, -1, -11])

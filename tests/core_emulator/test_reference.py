@@ -342,6 +342,18 @@ def test_unknown_opcodes_are_no_ops(op):
 def test_profiles_match_the_doc_table():
     assert PROFILES["chip8"] == RefQuirks(True, True, True, True, True, False)
     assert PROFILES["schip"] == RefQuirks(False, False, False, True, False, True)
+    assert PROFILES["xochip"] == RefQuirks(False, True, False, False, True, False)
+
+
+def test_profiles_are_the_cores():
+    """The oracle's profiles are written apart from the core's, so compare them field by field."""
+    import dataclasses
+
+    import octax_core
+
+    assert set(PROFILES) == set(octax_core.QUIRK_PROFILES)
+    for name, quirks in octax_core.QUIRK_PROFILES.items():
+        assert dataclasses.asdict(quirks) == dataclasses.asdict(PROFILES[name]), name
 
 
 def test_clone_is_independent():

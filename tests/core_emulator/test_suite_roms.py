@@ -10,6 +10,7 @@ Runs use one static frame count (60 frames, a "second"), so each machine config 
 
 from __future__ import annotations
 
+import dataclasses
 import hashlib
 import re
 
@@ -245,26 +246,28 @@ QUIRK_ROWS = [  # (label, field, y) from 5-quirks.8o: label at (1, y), result at
     ("VF RESET", "vf_reset", 1), ("MEMORY", "memory_increment", 6), ("DISP.WAIT", "display_wait", 11),
     ("CLIPPING", "clipping", 16), ("SHIFTING", "shift_uses_vy", 21), ("JUMPING", "jump_uses_vx", 26),
 ]
-CHIP8_MODE, SCHIP_MODE = 1, 2  # 5-quirks.8o `:const CHIP8 1`, `:const SCHIP_MODERN 2`
+CHIP8_MODE, SCHIP_MODE, XOCHIP_MODE = 1, 2, 3  # 5-quirks.8o `:const CHIP8 1`, `SCHIP_MODERN 2`, `XOCHIP 3`
 # What each platform expects the quirk to be (the ROM draws a check when the reading matches).
 QUIRK_TARGETS = {
     CHIP8_MODE: dict(vf_reset=True, memory_increment=True, display_wait=True, clipping=True,
                      shift_uses_vy=True, jump_uses_vx=False),
     SCHIP_MODE: dict(vf_reset=False, memory_increment=False, display_wait=False, clipping=True,
                      shift_uses_vy=False, jump_uses_vx=True),
+    XOCHIP_MODE: dict(vf_reset=False, memory_increment=True, display_wait=False, clipping=False,
+                      shift_uses_vy=True, jump_uses_vx=False),
 }
 
 
 def quirk_reading(mode, field, value):
     """The word 5-quirks prints for a quirk setting.
 
-    SHIFTING reads ON when VX is shifted in place (our shift_uses_vy off). In SUPER-CHIP mode
+    SHIFTING reads ON when VX is shifted in place (our shift_uses_vy off). In SUPER-CHIP and XO-CHIP modes
     the ROM measures lores and hires and prints BOTH/NONE; `hires` is a no-op here, so both
     measurements agree.
     """
     if field == "shift_uses_vy":
         value = not value
-    if mode == SCHIP_MODE and field in ("display_wait", "clipping"):
+    if mode in (SCHIP_MODE, XOCHIP_MODE) and field in ("display_wait", "clipping"):
         return "BOTH" if value else "NONE"
     return "ON" if value else "OFF"
 
@@ -291,9 +294,10 @@ def run_quirks(run, machine, mode):
     return got, screen
 
 
-@pytest.mark.parametrize("profile, mode", [("chip8", CHIP8_MODE), ("schip", SCHIP_MODE)])
+@pytest.mark.parametrize("profile, mode", [("chip8", CHIP8_MODE), ("schip", SCHIP_MODE), ("xochip", XOCHIP_MODE)])
 def test_quirks_profile_passes(run, profile, mode):
     machine = machine_for(profile)
+    assert dataclasses.asdict(machine.quirks) == QUIRK_TARGETS[mode]  # the profile is what the ROM expects
     got, screen = run_quirks(run, machine, mode)
     quirks = machine.quirks
     expected = {f: (quirk_reading(mode, f, getattr(quirks, f)), "ok") for _, f, _ in QUIRK_ROWS}
