@@ -126,6 +126,11 @@ def xorshift32(r):
     return r
 
 
+def assemble(*words):
+    """16-bit opcode words as program bytes, big-endian."""
+    return b"".join(w.to_bytes(2, "big") for w in words)
+
+
 def keys_to_list(keys):
     """An int mask (bit k = key k) or 16 bools, as a list of 16 bools."""
     if isinstance(keys, (int, np.integer)):
@@ -168,10 +173,10 @@ class RefMachine:
             self.planes = [[[False] * 128 for _ in range(64)] for _ in range(2 if platform == "xochip" else 1)]
             self.hires = False
             self.flags = [0] * 16
-            self.exited = False
             self.plane = 1  # the selected planes (XO-CHIP FN01); schip always draws on plane 1
             self.audio_pattern = [0] * 16
             self.pitch = 64
+        self.exited = False       # 00FD ran (SUPER-CHIP and XO-CHIP only; shown in their snapshots)
         self.rng = rng & 0xFFFFFFFF
         self.key_wait = NO_KEY
         self.rnd_ran = False      # did a CXNN run during the last run_frame
@@ -452,11 +457,11 @@ class RefMachine:
         that starts after 00FD (SUPER-CHIP exit) does nothing at all; the frame of the 00FD
         stops there and still ticks its timers."""
         self.rnd_ran = False
-        if getattr(self, "exited", False):
+        if self.exited:
             return
         for _ in range(self.instructions_per_frame):
             op = self.execute(keys)
-            if self.quirks.display_wait and op >> 12 == 0xD or getattr(self, "exited", False):
+            if self.quirks.display_wait and op >> 12 == 0xD or self.exited:
                 break
         if self.delay_timer > 0:
             self.delay_timer -= 1

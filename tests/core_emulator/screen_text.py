@@ -25,6 +25,12 @@ CORAX_NO = (0x00, 0xA0, 0x40, 0xA0)
 FLAG_OK = (0xA0, 0xC0, 0x80)
 FLAG_ERR = (0xA0, 0x40, 0xA0)
 
+# 5-quirks.8o's result lines: (label, Quirks field, y); label at (1, y), result at (42, y), mark at (59, y + 1).
+QUIRK_ROWS = [
+    ("VF RESET", "vf_reset", 1), ("MEMORY", "memory_increment", 6), ("DISP.WAIT", "display_wait", 11),
+    ("CLIPPING", "clipping", 16), ("SHIFTING", "shift_uses_vy", 21), ("JUMPING", "jump_uses_vx", 26),
+]
+
 # The 3x4 character set shared by 4-flags, 5-quirks and 6-keypad (`im0` .. `imPeriod`), in
 # the order of their `:stringmode str "$0123456789ABCDEFGHIJKLMNOPQRSTUVWXYZ -."`.
 GLYPHS: dict[str, tuple[int, int, int, int]] = {

@@ -6,7 +6,7 @@ program, runs it on the reference only, and checks registers, memory and screen 
 
 import numpy as np
 import pytest
-from reference import FONT_ADDRESS, NO_KEY, PROFILES, RefMachine, RefQuirks, xorshift32
+from reference import FONT_ADDRESS, NO_KEY, PROFILES, RefMachine, RefQuirks, assemble, xorshift32
 
 START_PC = 0x200
 OPCODE_SIZE = 2
@@ -15,10 +15,6 @@ SKIPPED_PC = START_PC + 2 * OPCODE_SIZE
 
 WRAPPING = RefQuirks(vf_reset=False, memory_increment=False, display_wait=False,
                      clipping=False, shift_uses_vy=False, jump_uses_vx=False)
-
-
-def assemble(*words):
-    return b"".join(w.to_bytes(2, "big") for w in words)
 
 
 def run(*words, quirks="chip8", keys=0, rng=1):

@@ -11,14 +11,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 import screen_text as st
-from reference import BIG_FONT, BIG_FONT_ADDRESS, PROFILES, RefMachine
+from reference import BIG_FONT, BIG_FONT_ADDRESS, PROFILES, RefMachine, assemble
 from screen_text import FLAG_ERR, FLAG_OK
 
 START = 0x200
-
-
-def assemble(*words):
-    return b"".join(w.to_bytes(2, "big") for w in words)
 
 
 def machine(*words, platform="schip", quirks=None, data=b""):
@@ -192,9 +188,6 @@ def test_scroll_up_audio_and_pitch():
 
 # --------------------------------------------------------------------------- the Timendus suite
 
-QUIRK_MARK_ROWS = (1, 6, 11, 16, 21, 26)  # 5-quirks.8o: a result mark at (59, y + 1) for each quirk
-
-
 def suite_machine(rom, mode, platform, ipf):
     data = (st.SUITE / f"{rom}.ch8").read_bytes()
     m = RefMachine(data, platform, instructions_per_frame=ipf, platform=platform)
@@ -220,7 +213,7 @@ def test_quirks_rom_passes_every_quirk(mode, platform):
         if st.mark_at(screen_pixels(m), 59, 27, FLAG_OK, FLAG_ERR) != "missing":
             break
     screen = screen_pixels(m)
-    marks = [st.mark_at(screen, 59, y + 1, FLAG_OK, FLAG_ERR) for y in QUIRK_MARK_ROWS]
+    marks = [st.mark_at(screen, 59, y + 1, FLAG_OK, FLAG_ERR) for _, _, y in st.QUIRK_ROWS]
     assert marks == ["ok"] * 6, st.to_text(screen)
 
 

@@ -242,10 +242,7 @@ def test_flags_check_catches_a_wrong_flag(run):
 
 # --------------------------------------------------------------------------- 5-quirks
 
-QUIRK_ROWS = [  # (label, field, y) from 5-quirks.8o: label at (1, y), result at (42, y), mark at (59, y + 1)
-    ("VF RESET", "vf_reset", 1), ("MEMORY", "memory_increment", 6), ("DISP.WAIT", "display_wait", 11),
-    ("CLIPPING", "clipping", 16), ("SHIFTING", "shift_uses_vy", 21), ("JUMPING", "jump_uses_vx", 26),
-]
+QUIRK_ROWS = st.QUIRK_ROWS
 CHIP8_MODE, SCHIP_MODE, XOCHIP_MODE = 1, 2, 3  # 5-quirks.8o `:const CHIP8 1`, `SCHIP_MODERN 2`, `XOCHIP 3`
 # What each platform expects the quirk to be (the ROM draws a check when the reading matches).
 QUIRK_TARGETS = {
