@@ -324,7 +324,7 @@ class RefMachine:
                     self.memory[(self.I + k) % size] = V[r]
                 else:
                     V[r] = self._mem(self.I + k)
-        elif xo and family == 0xF and nn == 0x01:
+        elif xo and family == 0xF and nn == 0x01 and x <= 3:  # planes 0..3; F401.. are unknown
             self.plane = x
         elif xo and op == 0xF002:
             self.audio_pattern = [self._mem(self.I + k) for k in range(16)]

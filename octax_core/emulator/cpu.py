@@ -92,6 +92,9 @@ def merge(kind, effects: dict, defaults: Effect) -> Effect:
     it, else the field of `defaults`. A chain of scalar selects per field, no branching."""
     merged = {}
     for field, default in zip(Effect._fields, defaults):
+        if default is None:  # a field this platform does not have (SUPER-CHIP's, on CHIP-8)
+            merged[field] = None
+            continue
         value = default
         for handler_kind, effect in effects.items():
             if getattr(effect, field) is not None:

@@ -1,36 +1,53 @@
 """Opcode decoding: bit slicing plus one lookup table that names each opcode's kind.
 
 The table is data, not an if-chain (fogleman/nes keeps its 256-entry instruction tables the same
-way): `KIND_TABLE[opcode >> 12, opcode & 0xFF]` gives the instruction kind; only 0x0XNN needs X
-as well (00E0 and 00EE exist, 01E0 does not). It is built from `opcodes.OPCODES`, the one list of
-opcodes that the disassembler reads too.
+way), built from `opcodes.OPCODES`, the one list of opcodes that the disassembler reads too.
+CHIP-8 reads `KIND_TABLE[opcode >> 12, opcode & 0xFF]` (4 KB); only 0x0XNN needs X as well
+(00E0 and 00EE exist, 01E0 does not). SUPER-CHIP and XO-CHIP have opcodes that need X too (F000,
+F002, FN01 with N in 0..3), so they read one entry per 16-bit word (`word_table`, 64 KB).
 """
 
 from __future__ import annotations
 
+import functools
 from typing import NamedTuple
 
 import jax
 import jax.numpy as jnp
 import numpy as np
 
-from octax_core.emulator.opcodes import Kind, lookup
+from octax_core.emulator.opcodes import LEVELS, OPCODES, Kind, lookup
 
-__all__ = ["Decoded", "KIND_TABLE", "Kind", "decode"]
+__all__ = ["Decoded", "KIND_TABLE", "Kind", "decode", "word_table"]
 
 
 def _build_kind_table() -> np.ndarray:
-    """The kind of every (top nibble, low byte) pair, read with X = 0 (`decode` handles 0X__)."""
+    """The CHIP-8 kind of every (top nibble, low byte) pair, read with X = 0 (`decode` handles 0X__)."""
     table = np.full((16, 256), Kind.NOP, np.uint8)
     for top in range(16):
         for low in range(256):
             row = lookup(top << 12 | low)
-            if row is not None and row.kind is not None:
+            if row is not None and row.kind is not None and LEVELS[row.platform] == 0:
                 table[top, low] = row.kind
     return table
 
 
 KIND_TABLE = _build_kind_table()  # (16, 256) uint8, numpy: no device array at import
+
+
+@functools.lru_cache(maxsize=None)
+def word_table(platform: str) -> np.ndarray:
+    """(65536,) uint8: the kind a `platform` machine runs each 16-bit word as (`opcodes.kind_on`).
+
+    Filled row by row, last row first, so that the first matching row wins, as in `lookup`.
+    """
+    words = np.arange(0x10000, dtype=np.uint32)
+    table = np.full(0x10000, Kind.NOP, np.uint8)
+    for row in reversed(OPCODES):
+        known = row.kind is not None and LEVELS[row.platform] <= LEVELS[platform]
+        table[(words & row.mask) == row.pattern] = row.kind if known else Kind.NOP
+    table.flags.writeable = False
+    return table
 
 
 class Decoded(NamedTuple):
@@ -44,10 +61,13 @@ class Decoded(NamedTuple):
     nnn: jax.Array
 
 
-def decode(high: jax.Array, low: jax.Array) -> Decoded:
-    """Splits the two opcode bytes into fields and looks up the instruction kind."""
+def decode(high: jax.Array, low: jax.Array, platform: str = "chip8") -> Decoded:
+    """Splits the two opcode bytes into fields and looks up the instruction kind on `platform`."""
     high, low = high.astype(jnp.int32), low.astype(jnp.int32)
     top, x = high >> 4, high & 0xF
-    kind = jnp.asarray(KIND_TABLE.reshape(-1))[top * 256 + low].astype(jnp.int32)
-    kind = jnp.where((top == 0) & (x != 0), int(Kind.NOP), kind)  # 0NNN machine-code calls
+    if platform == "chip8":
+        kind = jnp.asarray(KIND_TABLE.reshape(-1))[top * 256 + low].astype(jnp.int32)
+        kind = jnp.where((top == 0) & (x != 0), int(Kind.NOP), kind)  # 0NNN machine-code calls
+    else:
+        kind = jnp.asarray(word_table(platform))[high * 256 + low].astype(jnp.int32)
     return Decoded(kind=kind, x=x, y=low >> 4, n=low & 0xF, nn=low, nnn=(x << 8) | low)

@@ -1,6 +1,6 @@
-"""`Machine`: the frozen configuration of a CHIP-8 interpreter and its pure entry points.
+"""`Machine`: the frozen configuration of an interpreter and its pure entry points.
 
-The config (quirks, instructions per frame) shapes the traced program, so it is a hashable
+The config (platform, quirks, instructions per frame) shapes the traced program, so it is a hashable
 value closed over by `jit`, never a field of the state. Methods are pure functions of their
 arguments: wrap them with `jax.jit` / `jax.vmap` as needed, e.g.
 `jax.jit(machine.run_frames, static_argnums=2)`.
@@ -15,8 +15,9 @@ from typing import Union
 import jax
 import jax.numpy as jnp
 
-from octax_core.emulator import cpu
+from octax_core.emulator import cpu, cpu_extended
 from octax_core.emulator.keypad import keys_to_mask
+from octax_core.emulator.platforms import Platform, check_program_fits, resolve_platform
 from octax_core.emulator.quirks import Quirks, resolve_quirks
 from octax_core.emulator.rom import Rom, RomLike
 from octax_core.emulator.state import MachineState, boot_state
@@ -25,10 +26,14 @@ from octax_core.validate import check_int
 
 @dataclasses.dataclass(frozen=True)
 class Machine:
-    """A CHIP-8 interpreter configuration.
+    """An interpreter configuration: which machine, how it behaves, how fast it runs.
 
     Args:
-        quirks: a profile name ("chip8", "schip", "xochip"; `QUIRK_PROFILES`) or a `Quirks`.
+        platform: "chip8" (64x32, 4 KiB), "schip" (SUPER-CHIP: 128x64 and 64x32 modes, scrolling,
+            16x16 sprites, big digits, flags, exit) or "xochip" (XO-CHIP: SUPER-CHIP plus 64 KiB,
+            two bit planes, long I, register ranges, audio registers); or a `Platform`.
+        quirks: a profile name ("chip8", "schip", "xochip"; `QUIRK_PROFILES`) or a `Quirks`;
+            None (the default) takes the platform's own profile, the one of the same name.
         instructions_per_frame: instructions run per 60 Hz frame (11 is about the COSMAC VIP's
             speed on typical game code).
 
@@ -41,11 +46,14 @@ class Machine:
         512
     """
 
-    quirks: Union[Quirks, str] = "chip8"
+    platform: Union[Platform, str] = "chip8"
+    quirks: Union[Quirks, str, None] = None
     instructions_per_frame: int = 11
 
     def __post_init__(self):
-        object.__setattr__(self, "quirks", resolve_quirks(self.quirks))
+        platform = resolve_platform(self.platform)
+        object.__setattr__(self, "platform", platform)
+        object.__setattr__(self, "quirks", resolve_quirks(platform.default_quirks if self.quirks is None else self.quirks))
         object.__setattr__(self, "instructions_per_frame",
                            check_int("instructions_per_frame", self.instructions_per_frame))
 
@@ -53,12 +61,22 @@ class Machine:
         """A powered-on machine with `rom` loaded at 0x200; the key seeds CXNN.
 
         Jittable and vmappable over `key` (the ROM is baked in as a constant).
+
+        Raises:
+            ValueError: the ROM is empty, or larger than the platform holds (3584 bytes on
+                chip8 and schip, 65024 on xochip).
         """
-        return boot_state(Rom.load(rom), key)
+        rom = Rom.load(rom)
+        check_program_fits(len(rom.data), rom.name, self.platform)
+        return boot_state(rom, key, self.platform)
 
     def execute(self, state: MachineState, keys) -> MachineState:
         """Runs exactly one instruction (no timer tick, no display wait)."""
-        new_state, _ = cpu.execute(self.quirks, state, keys_to_mask(keys))
+        if self.platform.extended:
+            new_state, _ = cpu_extended.execute(self.platform, self.quirks, state, keys_to_mask(keys),
+                                                jnp.zeros((), jnp.bool_) | state.exited)
+        else:
+            new_state, _ = cpu.execute(self.quirks, state, keys_to_mask(keys))
         return new_state
 
     def run_frames(self, state: MachineState, keys, frames, *, halted=None, record_screens: bool = False):
@@ -76,7 +94,8 @@ class Machine:
 
         Returns:
             The state after the frames; with `record_screens`, `(state, screens)` where screens
-            is (frames, 32, 2) uint32 (`octax_core.emulator.state.unpack_screen` unpacks it).
+            is (frames, 32, 2) uint32 on CHIP-8, (frames, planes, 64, 4) on SUPER-CHIP and
+            XO-CHIP (`octax_core.emulator.state.unpack_screen` unpacks either).
 
         Raises:
             TypeError: `frames` is neither an int nor an integer scalar array, or is an array
@@ -86,6 +105,9 @@ class Machine:
         mask = keys_to_mask(keys)
 
         def frame(state):
+            if self.platform.extended:
+                return cpu_extended.run_frame(self.platform, self.quirks, self.instructions_per_frame, state,
+                                              mask, halted)
             return cpu.run_frame(self.quirks, self.instructions_per_frame, state, mask, halted)
 
         if isinstance(frames, jax.Array) and not record_screens:

@@ -2,8 +2,8 @@
 
 One row per opcode: the bits that identify it (`mask`, `pattern`: a word is that opcode when
 `word & mask == pattern`; the first matching row wins), the `Kind` the emulator runs it as (None
-for a word it does not run: SUPER-CHIP and XO-CHIP opcodes until those platforms exist, and
-0NNN machine-code calls), the platform that introduced it, the Octo statement that writes it and
+for a word it does not run: 0NNN machine-code calls), the platform that introduced it (on an
+earlier platform the word is an unknown opcode, a no-op: `kind_on`), the Octo statement that writes it and
 where execution may go next (`Flow`). The decoder (`decode.KIND_TABLE`) and the disassembler
 (`octax_core.tools.octo.disassembler`) both read this table, so a new opcode is one row here.
 """
@@ -53,6 +53,24 @@ class Kind(enum.IntEnum):
     BCD = enum.auto()  # FX33
     STORE = enum.auto()  # FX55
     LOAD = enum.auto()  # FX65
+    # SUPER-CHIP
+    SCROLL_DOWN = enum.auto()  # 00CN
+    SCROLL_RIGHT = enum.auto()  # 00FB
+    SCROLL_LEFT = enum.auto()  # 00FC
+    EXIT = enum.auto()  # 00FD
+    LORES = enum.auto()  # 00FE
+    HIRES = enum.auto()  # 00FF
+    LD_BIG_FONT = enum.auto()  # FX30
+    SAVE_FLAGS = enum.auto()  # FX75
+    LOAD_FLAGS = enum.auto()  # FX85
+    # XO-CHIP
+    SCROLL_UP = enum.auto()  # 00DN
+    SAVE_RANGE = enum.auto()  # 5XY2
+    LOAD_RANGE = enum.auto()  # 5XY3
+    LD_I_LONG = enum.auto()  # F000 NNNN
+    PLANE = enum.auto()  # FN01
+    AUDIO = enum.auto()  # F002
+    PITCH = enum.auto()  # FX3A
 
 
 class Flow(enum.Enum):
@@ -84,13 +102,13 @@ _C, _S, _X = "chip8", "schip", "xochip"
 OPCODES: tuple[Opcode, ...] = (
     Opcode(0xFFFF, 0x00E0, Kind.CLS, _C, "clear", Flow.NEXT),
     Opcode(0xFFFF, 0x00EE, Kind.RET, _C, "return", Flow.STOP),
-    Opcode(0xFFF0, 0x00C0, None, _S, "scroll-down {n}", Flow.NEXT),
-    Opcode(0xFFF0, 0x00D0, None, _X, "scroll-up {n}", Flow.NEXT),
-    Opcode(0xFFFF, 0x00FB, None, _S, "scroll-right", Flow.NEXT),
-    Opcode(0xFFFF, 0x00FC, None, _S, "scroll-left", Flow.NEXT),
-    Opcode(0xFFFF, 0x00FD, None, _S, "exit", Flow.STOP),
-    Opcode(0xFFFF, 0x00FE, None, _S, "lores", Flow.NEXT),
-    Opcode(0xFFFF, 0x00FF, None, _S, "hires", Flow.NEXT),
+    Opcode(0xFFF0, 0x00C0, Kind.SCROLL_DOWN, _S, "scroll-down {n}", Flow.NEXT),
+    Opcode(0xFFF0, 0x00D0, Kind.SCROLL_UP, _X, "scroll-up {n}", Flow.NEXT),
+    Opcode(0xFFFF, 0x00FB, Kind.SCROLL_RIGHT, _S, "scroll-right", Flow.NEXT),
+    Opcode(0xFFFF, 0x00FC, Kind.SCROLL_LEFT, _S, "scroll-left", Flow.NEXT),
+    Opcode(0xFFFF, 0x00FD, Kind.EXIT, _S, "exit", Flow.STOP),
+    Opcode(0xFFFF, 0x00FE, Kind.LORES, _S, "lores", Flow.NEXT),
+    Opcode(0xFFFF, 0x00FF, Kind.HIRES, _S, "hires", Flow.NEXT),
     Opcode(0xFFFF, 0x0000, None, _C, None, None),  # 0000 is padding far more often than a machine-code call
     Opcode(0xF000, 0x0000, None, _C, "native {nnn}", Flow.NEXT),  # machine code: the emulator skips it
     Opcode(0xF000, 0x1000, Kind.JP, _C, "jump {target}", Flow.JUMP),
@@ -98,8 +116,8 @@ OPCODES: tuple[Opcode, ...] = (
     Opcode(0xF000, 0x3000, Kind.SE_NN, _C, "if {x} != {nn} then", Flow.SKIP),  # `if C then S` skips S when C is false
     Opcode(0xF000, 0x4000, Kind.SNE_NN, _C, "if {x} == {nn} then", Flow.SKIP),
     Opcode(0xF00F, 0x5000, Kind.SE_XY, _C, "if {x} != {y} then", Flow.SKIP),
-    Opcode(0xF00F, 0x5002, None, _X, "save {x} - {y}", Flow.NEXT),
-    Opcode(0xF00F, 0x5003, None, _X, "load {x} - {y}", Flow.NEXT),
+    Opcode(0xF00F, 0x5002, Kind.SAVE_RANGE, _X, "save {x} - {y}", Flow.NEXT),
+    Opcode(0xF00F, 0x5003, Kind.LOAD_RANGE, _X, "load {x} - {y}", Flow.NEXT),
     Opcode(0xF000, 0x6000, Kind.LD_NN, _C, "{x} := {nn}", Flow.NEXT),
     Opcode(0xF000, 0x7000, Kind.ADD_NN, _C, "{x} += {nn}", Flow.NEXT),
     Opcode(0xF00F, 0x8000, Kind.LD_XY, _C, "{x} := {y}", Flow.NEXT),
@@ -118,25 +136,37 @@ OPCODES: tuple[Opcode, ...] = (
     Opcode(0xF000, 0xD000, Kind.DRW, _C, "sprite {x} {y} {n}", Flow.NEXT),
     Opcode(0xF0FF, 0xE09E, Kind.SKP, _C, "if {x} -key then", Flow.SKIP),
     Opcode(0xF0FF, 0xE0A1, Kind.SKNP, _C, "if {x} key then", Flow.SKIP),
-    Opcode(0xFFFF, 0xF000, None, _X, "i := long {target}", Flow.INDEX),  # the address is the next word
-    Opcode(0xFCFF, 0xF001, None, _X, "plane {xn}", Flow.NEXT),  # Octo takes plane masks 0-3 only
-    Opcode(0xFFFF, 0xF002, None, _X, "audio", Flow.NEXT),
+    Opcode(0xFFFF, 0xF000, Kind.LD_I_LONG, _X, "i := long {target}", Flow.INDEX),  # the address is the next word
+    Opcode(0xFCFF, 0xF001, Kind.PLANE, _X, "plane {xn}", Flow.NEXT),  # Octo takes plane masks 0-3 only
+    Opcode(0xFFFF, 0xF002, Kind.AUDIO, _X, "audio", Flow.NEXT),
     Opcode(0xF0FF, 0xF007, Kind.LD_VX_DT, _C, "{x} := delay", Flow.NEXT),
     Opcode(0xF0FF, 0xF00A, Kind.LD_KEY, _C, "{x} := key", Flow.NEXT),
     Opcode(0xF0FF, 0xF015, Kind.LD_DT, _C, "delay := {x}", Flow.NEXT),
     Opcode(0xF0FF, 0xF018, Kind.LD_ST, _C, "buzzer := {x}", Flow.NEXT),
     Opcode(0xF0FF, 0xF01E, Kind.ADD_I, _C, "i += {x}", Flow.NEXT),
     Opcode(0xF0FF, 0xF029, Kind.LD_FONT, _C, "i := hex {x}", Flow.NEXT),
-    Opcode(0xF0FF, 0xF030, None, _S, "i := bighex {x}", Flow.NEXT),
+    Opcode(0xF0FF, 0xF030, Kind.LD_BIG_FONT, _S, "i := bighex {x}", Flow.NEXT),
     Opcode(0xF0FF, 0xF033, Kind.BCD, _C, "bcd {x}", Flow.NEXT),
-    Opcode(0xF0FF, 0xF03A, None, _X, "pitch := {x}", Flow.NEXT),
+    Opcode(0xF0FF, 0xF03A, Kind.PITCH, _X, "pitch := {x}", Flow.NEXT),
     Opcode(0xF0FF, 0xF055, Kind.STORE, _C, "save {x}", Flow.NEXT),
     Opcode(0xF0FF, 0xF065, Kind.LOAD, _C, "load {x}", Flow.NEXT),
-    Opcode(0xF8FF, 0xF075, None, _S, "saveflags {x}", Flow.NEXT),  # Octo's flags registers are v0-v7
-    Opcode(0xF8FF, 0xF085, None, _S, "loadflags {x}", Flow.NEXT),
+    Opcode(0xF0FF, 0xF075, Kind.SAVE_FLAGS, _S, "saveflags {x}", Flow.NEXT),  # 16 flags, as Octo
+    Opcode(0xF0FF, 0xF085, Kind.LOAD_FLAGS, _S, "loadflags {x}", Flow.NEXT),
 )
+
+
+LEVELS = {_C: 0, _S: 1, _X: 2}  # each platform runs the opcodes of its own level and below
 
 
 def lookup(word: int) -> Optional[Opcode]:
     """The first row of `OPCODES` that `word` (0..0xFFFF) matches, or None."""
     return next((row for row in OPCODES if word & row.mask == row.pattern), None)
+
+
+def kind_on(word: int, platform: str) -> Kind:
+    """The kind a `platform` machine runs `word` as: NOP for a word that platform does not know
+    (no row, a row without a kind, or a row of a later platform)."""
+    row = lookup(word)
+    if row is None or row.kind is None or LEVELS[row.platform] > LEVELS[platform]:
+        return Kind.NOP
+    return row.kind

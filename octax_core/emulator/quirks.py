@@ -63,6 +63,33 @@ QUIRK_PROFILES: dict[str, Quirks] = {
 }
 
 
+OCTO_QUIRK_OPTIONS = ("shiftQuirks", "loadStoreQuirks", "vfOrderQuirks", "clipQuirks", "jumpQuirks",
+                      "vBlankQuirks", "logicQuirks")
+
+
+def quirks_from_octo(options: dict) -> Quirks:
+    """The `Quirks` that Octo's option flags describe (the Chip8 Community Archive's programs.json
+    gives each program its own). A flag left out is false, as in Octo; other keys (colours,
+    tickrate, ...) are ignored.
+
+    Raises:
+        ValueError: vfOrderQuirks is set (flags written before the result; not modelled) or a
+            flag is not true, false, 1 or 0.
+    """
+    flags = {}
+    for name in OCTO_QUIRK_OPTIONS:
+        value = options.get(name, False)
+        if value not in (False, True):  # the archive writes both true/false and 1/0
+            raise ValueError(f"Octo option {name} must be true, false, 1 or 0, got {value!r}")
+        flags[name] = bool(value)
+    if flags["vfOrderQuirks"]:
+        raise ValueError("Octo's vfOrderQuirks (VF written before the result) is not modelled; "
+                         "every instruction here writes its flag after its result")
+    return Quirks(vf_reset=flags["logicQuirks"], memory_increment=not flags["loadStoreQuirks"],
+                  display_wait=flags["vBlankQuirks"], clipping=flags["clipQuirks"],
+                  shift_uses_vy=not flags["shiftQuirks"], jump_uses_vx=flags["jumpQuirks"])
+
+
 def resolve_quirks(quirks: Union[str, Quirks]) -> Quirks:
     """Returns the `Quirks` for a profile name, or `quirks` itself.
 

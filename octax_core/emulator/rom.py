@@ -1,4 +1,4 @@
-"""CHIP-8 program images: validation and loading.
+"""CHIP-8, SUPER-CHIP and XO-CHIP program images: validation and loading.
 
 A `Rom` is plain bytes plus a name; it never touches JAX. Bad input fails here, early, with a
 message that says what was wrong, instead of surfacing later as a silently truncated program.
@@ -14,22 +14,24 @@ from typing import Union
 
 PROGRAM_ADDRESS = 0x200
 MEMORY_SIZE = 0x1000
-MAX_ROM_SIZE = MEMORY_SIZE - PROGRAM_ADDRESS  # 3584 bytes
+MAX_ROM_SIZE = MEMORY_SIZE - PROGRAM_ADDRESS  # 3584 bytes: CHIP-8 and SUPER-CHIP
+MAX_XOCHIP_ROM_SIZE = 0x10000 - PROGRAM_ADDRESS  # 65024 bytes: XO-CHIP's 64 KiB
 
 RomLike = Union["Rom", bytes, bytearray, memoryview, str, os.PathLike]
 
 
 @dataclasses.dataclass(frozen=True)
 class Rom:
-    """A validated CHIP-8 program image.
+    """A validated program image.
 
     Args:
-        data: the program bytes, loaded at 0x200; 1 to 3584 bytes.
+        data: the program bytes, loaded at 0x200; 1 to 65024 bytes (XO-CHIP's 64 KiB; a CHIP-8
+            or SUPER-CHIP machine takes at most 3584, which `Machine.boot` checks).
         name: a label for messages and listings.
 
     Raises:
         TypeError: `data` is not bytes-like.
-        ValueError: `data` is empty or longer than 3584 bytes.
+        ValueError: `data` is empty or longer than 65024 bytes.
     """
 
     data: bytes
@@ -44,10 +46,10 @@ class Rom:
         object.__setattr__(self, "data", data)
         if not data:
             raise ValueError(f"ROM {self.name!r} is empty: a CHIP-8 program needs at least 1 byte")
-        if len(data) > MAX_ROM_SIZE:
+        if len(data) > MAX_XOCHIP_ROM_SIZE:
             raise ValueError(
-                f"ROM {self.name!r} is {len(data)} bytes; a CHIP-8 program loaded at 0x200 "
-                f"holds at most {MAX_ROM_SIZE} bytes"
+                f"ROM {self.name!r} is {len(data)} bytes; a program loaded at 0x200 holds at most "
+                f"{MAX_ROM_SIZE} bytes on chip8 and schip, {MAX_XOCHIP_ROM_SIZE} on xochip"
             )
 
     @property

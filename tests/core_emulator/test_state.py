@@ -36,7 +36,7 @@ def test_poke_wraps_and_keeps_the_mirror():
 
 def test_poke_then_fx65_near_the_end_reads_through_the_wrap():
     # A6FE; F365: load V0..V3 from 0xFFE, 0xFFF, 0x000, 0x001.
-    machine = octax_core.Machine("schip")
+    machine = octax_core.Machine(quirks="schip")
     state = machine.boot(bytes([0xAF, 0xFE, 0xF3, 0x65]), jax.random.key(0))
     state = octax_core.poke(state, 0xFFE, bytes([9, 8, 7, 6]))
     state = machine.execute(machine.execute(state, 0), 0)
@@ -45,7 +45,7 @@ def test_poke_then_fx65_near_the_end_reads_through_the_wrap():
 
 def test_render_text_draws_lit_pixels():
     # 00E0; A050 (font "0"); D015 at (0, 0): the 4x5 glyph of 0 in the top-left corner.
-    machine = octax_core.Machine("schip")
+    machine = octax_core.Machine(quirks="schip")
     state = machine.boot(bytes([0x00, 0xE0, 0xA0, 0x50, 0xD0, 0x15]), jax.random.key(0))
     for _ in range(3):
         state = machine.execute(state, 0)

@@ -43,7 +43,7 @@ def _runner(machine: octax_core.Machine):
 def _start(game_id: str, rom_dir):
     """The spec's machine booted as `make` does (key 0) and run through the spec's start-up."""
     spec = get_spec(game_id)
-    machine = octax_core.Machine(spec.quirks, instructions_per_frame=11)
+    machine = octax_core.Machine(quirks=spec.quirks, instructions_per_frame=11)
     state = machine.boot(rom_dir / spec.rom_file, jax.random.key(0))
     for mask, frames in spec.startup:
         state = _runner(machine)(state, mask, frames)
