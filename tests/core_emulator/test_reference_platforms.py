@@ -1,4 +1,5 @@
-"""The reference interpreter's SUPER-CHIP and XO-CHIP (issue 12), checked before the core has them.
+"""SUPER-CHIP and XO-CHIP (issue 12): the reference interpreter by hand, and the Timendus verdicts
+on both the reference and the JAX core.
 
 Two kinds of check, neither reading the JAX code: tiny programs whose registers, memory and
 screens are worked out by hand from the platform contract (tests/reference.py's docstring), and
@@ -188,31 +189,56 @@ def test_scroll_up_audio_and_pitch():
 
 # --------------------------------------------------------------------------- the Timendus suite
 
-def suite_machine(rom, mode, platform, ipf):
-    data = (st.SUITE / f"{rom}.ch8").read_bytes()
-    m = RefMachine(data, platform, instructions_per_frame=ipf, platform=platform)
-    m.memory[0x1FF] = mode  # the suite's auto-start byte
-    return m
+class SuiteRun:
+    """A Timendus ROM with its mode byte set, on the reference ("reference") or the JAX core
+    ("core"): the same verdicts must hold on both."""
+
+    def __init__(self, impl, rom, mode, platform, ipf):
+        data = (st.SUITE / f"{rom}.ch8").read_bytes()
+        self.impl = impl
+        if impl == "reference":
+            self.ref = RefMachine(data, platform, instructions_per_frame=ipf, platform=platform)
+            self.ref.memory[0x1FF] = mode  # the suite's auto-start byte
+        else:
+            import jax
+            import octax_core
+            machine = octax_core.Machine(platform, instructions_per_frame=ipf)
+            self.state = octax_core.poke(machine.boot(data, jax.random.key(0)), 0x1FF, bytes([mode]))
+            self.run = jax.jit(machine.run_frames, static_argnums=2)
+
+    def frames(self, count):
+        if self.impl == "reference":
+            self.ref.run_frames(0, count)
+        else:
+            self.state = self.run(self.state, 0, count)
+
+    def screen(self):
+        """Plane 1's visible screen in screen pixels: 64x32 in lores (each a uniform 2x2 block)."""
+        if self.impl == "reference":
+            grid, hires = np.array(self.ref.planes[0], dtype=bool), self.ref.hires
+        else:
+            import octax_core
+            snap = octax_core.snapshot(self.state)
+            grid, hires = snap["screen"].reshape(-1, 64, 128)[0], bool(snap["hires"])
+        if hires:
+            return grid
+        assert (grid[::2, ::2] == grid[1::2, ::2]).all() and (grid[::2, ::2] == grid[::2, 1::2]).all()
+        return grid[::2, ::2]
 
 
-def screen_pixels(m, plane=0):
-    """The visible screen of a plane in screen pixels: 64x32 in lores (each a uniform 2x2 block)."""
-    grid = np.array(m.planes[plane], dtype=bool)
-    if m.hires:
-        return grid
-    assert (grid[::2, ::2] == grid[1::2, ::2]).all() and (grid[::2, ::2] == grid[::2, 1::2]).all()
-    return grid[::2, ::2]
+IMPLEMENTATIONS = ("reference", "core")
 
 
 @pytest.mark.shared
+@pytest.mark.parametrize("impl", IMPLEMENTATIONS)
 @pytest.mark.parametrize("mode, platform", [(2, "schip"), (3, "xochip")])
-def test_quirks_rom_passes_every_quirk(mode, platform):
-    m = suite_machine("5-quirks", mode, platform, ipf=30)
-    for _ in range(15 * 60):
-        m.run_frame(0)
-        if st.mark_at(screen_pixels(m), 59, 27, FLAG_OK, FLAG_ERR) != "missing":
+def test_quirks_rom_passes_every_quirk(mode, platform, impl):
+    run = SuiteRun(impl, "5-quirks", mode, platform, ipf=30)
+    for _ in range(15 * 6):
+        run.frames(10)
+        if st.mark_at(run.screen(), 59, 27, FLAG_OK, FLAG_ERR) != "missing":
             break
-    screen = screen_pixels(m)
+    screen = run.screen()
     marks = [st.mark_at(screen, 59, y + 1, FLAG_OK, FLAG_ERR) for _, _, y in st.QUIRK_ROWS]
     assert marks == ["ok"] * 6, st.to_text(screen)
 
@@ -251,13 +277,13 @@ def border_pixels(mode):
 
 
 @pytest.mark.shared
+@pytest.mark.parametrize("impl", IMPLEMENTATIONS)
 @pytest.mark.parametrize("mode, platform", [(1, "schip"), (3, "schip"), (4, "xochip"), (5, "xochip")])
-def test_scrolling_rom_puts_every_arrow_in_a_box(mode, platform):
+def test_scrolling_rom_puts_every_arrow_in_a_box(mode, platform, impl):
     source = (st.SUITE / "8-scrolling.8o").read_text()
-    m = suite_machine("8-scrolling", mode, platform, ipf=100)
-    for _ in range(120):
-        m.run_frame(0)
-    screen = screen_pixels(m)
+    run = SuiteRun(impl, "8-scrolling", mode, platform, ipf=100)
+    run.frames(120)
+    screen = run.screen()
     on = {(x, y) for y, x in zip(*np.nonzero(screen))}
     border = border_pixels(mode)
     assert border <= on, st.to_text(screen)
