@@ -1,7 +1,8 @@
 """Bad input fails early, with the exception type and a message that names the problem.
 
-docs/machine.md, "Bad input": `Rom` refuses an empty program, one over 3584 bytes and anything
-that is not bytes, a path or a `Rom`; `Machine` refuses an unknown profile name (listing the
+docs/machine.md, "Bad input": `Rom` refuses an empty program, one over 65024 bytes (XO-CHIP's
+64 KiB) and anything that is not bytes, a path or a `Rom`, and `Machine.boot` one larger than its
+platform holds (3584 bytes on CHIP-8); `Machine` refuses an unknown profile name (listing the
 valid ones) and a non-positive `instructions_per_frame`.
 """
 
@@ -12,7 +13,8 @@ import pytest
 import octax_core
 from octax_core import Machine, Rom
 
-MAX = 3584  # 4096 - 0x200
+MAX = 3584  # 4096 - 0x200: CHIP-8 and SUPER-CHIP
+XOCHIP_MAX = 65024  # 65536 - 0x200
 
 
 @pytest.fixture
@@ -35,10 +37,16 @@ def test_empty_rom(way, key):
         loaders(key)[way](b"")
 
 
-@pytest.mark.parametrize("way", ["Rom", "Rom.load", "Machine.boot"])
 @pytest.mark.parametrize("size", [MAX + 1, 4096])
-def test_rom_too_large(way, key, size):
+def test_rom_too_large_for_chip8(key, size):
     with pytest.raises(ValueError, match=rf"{size}.*\b{MAX}\b"):
+        loaders(key)["Machine.boot"](bytes(size))
+
+
+@pytest.mark.parametrize("way", ["Rom", "Rom.load", "Machine.boot"])
+@pytest.mark.parametrize("size", [XOCHIP_MAX + 1, 70000])
+def test_rom_too_large_for_any_platform(way, key, size):
+    with pytest.raises(ValueError, match=rf"{size}.*\b{MAX}\b.*\b{XOCHIP_MAX}\b"):
         loaders(key)[way](bytes(size))
 
 
