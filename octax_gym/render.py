@@ -15,13 +15,14 @@ from octax_core.validate import check_int
 
 RGB = tuple[int, int, int]
 
-# (off, on) colours. "octo" is the Octo IDE's default pair; the rest are phosphor looks.
-PALETTES: dict[str, tuple[RGB, RGB]] = {
-    "white": ((0, 0, 0), (255, 255, 255)),
-    "octo": ((153, 102, 0), (255, 204, 0)),
-    "green": ((0, 24, 0), (51, 255, 102)),
-    "amber": ((24, 12, 0), (255, 176, 0)),
-    "blue": ((0, 0, 48), (120, 200, 255)),
+# (off, on) colours, then XO-CHIP's two more: plane 2 alone, and both planes. "octo" is the Octo
+# IDE's default set (background, fill, fill 2, blend); the rest are phosphor looks.
+PALETTES: dict[str, tuple[RGB, ...]] = {
+    "white": ((0, 0, 0), (255, 255, 255), (170, 170, 170), (85, 85, 85)),
+    "octo": ((153, 102, 0), (255, 204, 0), (255, 102, 0), (102, 34, 0)),
+    "green": ((0, 24, 0), (51, 255, 102), (20, 150, 60), (150, 255, 180)),
+    "amber": ((24, 12, 0), (255, 176, 0), (170, 90, 0), (255, 230, 150)),
+    "blue": ((0, 0, 48), (120, 200, 255), (40, 90, 200), (220, 240, 255)),
 }
 DEFAULT_PALETTE = "white"
 DEFAULT_RENDER_SCALE = 8
@@ -31,10 +32,14 @@ PaletteArg = Union[str, Sequence[Sequence[int]]]
 
 
 def resolve_palette(palette: PaletteArg) -> np.ndarray:
-    """A palette name or an (off, on) pair of RGB triples -> uint8 array (2, 3).
+    """A palette name, an (off, on) pair or an (off, plane 1, plane 2, both) set of RGB triples
+    -> uint8 array (4, 3), indexed by a pixel's value (`octax_core.emulator.state.screen_values`).
+
+    A pair serves XO-CHIP too: plane 2 alone is drawn halfway between off and on, both planes a
+    quarter of the way (CHIP-8 and SUPER-CHIP pixels only ever use the first two).
 
     Raises:
-        ValueError: an unknown name (the message lists the valid ones) or a malformed pair.
+        ValueError: an unknown name (the message lists the valid ones) or a malformed set.
     """
     if isinstance(palette, str):
         if palette not in PALETTES:
@@ -45,10 +50,13 @@ def resolve_palette(palette: PaletteArg) -> np.ndarray:
         colours = np.array(palette)
     except (TypeError, ValueError):
         colours = np.array(None)
-    if (colours.shape != (2, 3) or not np.issubdtype(colours.dtype, np.integer)
+    if (colours.shape not in ((2, 3), (4, 3)) or not np.issubdtype(colours.dtype, np.integer)
             or colours.min() < 0 or colours.max() > 255):
         raise ValueError(f"palette must be a name ({', '.join(PALETTES)}) or an (off, on) pair of "
-                         f"RGB triples with values 0..255, got {palette!r}")
+                         f"RGB triples (or 4: off, plane 1, plane 2, both) with values 0..255, got {palette!r}")
+    if len(colours) == 2:
+        off, on = colours.astype(np.int32)
+        colours = np.stack([off, on, (off + on) // 2, (3 * off + on) // 4])
     return colours.astype(np.uint8)
 
 
@@ -57,7 +65,8 @@ def check_render_scale(scale) -> int:
 
 
 def to_rgb(pixels: np.ndarray, scale: int, palette: np.ndarray) -> np.ndarray:
-    """(32, 64) bool pixels -> (32*scale, 64*scale, 3) uint8, upscaled nearest-neighbour by OpenCV."""
+    """(H, W) pixel values (bool, or 0..3 on XO-CHIP) -> (H*scale, W*scale, 3) uint8 in the
+    palette's colours, upscaled nearest-neighbour by OpenCV."""
     small = palette[pixels.astype(np.intp)]
     if scale == 1:
         return np.ascontiguousarray(small)

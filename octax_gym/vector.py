@@ -22,7 +22,7 @@ from gymnasium import spaces
 from gymnasium.vector import AutoresetMode
 
 from octax_gym import action_check, backends, program, render
-from octax_core.emulator.state import unpack_screen
+from octax_core.emulator.state import screen_values
 from octax_core.env.config import check_option_names
 from octax_core.validate import check_int
 from octax_gym.program import GYM_ENV_OPTIONS, build, keys_from_seeds, seeds_for
@@ -67,7 +67,9 @@ class OctaxVectorEnv(gymnasium.vector.VectorEnv):
             "cuda:1", a jax.Device or a torch.device.
         render_mode: None or "rgb_array" (`render()` returns a tuple of num_envs frames).
         render_scale: pixel size of a rendered frame (default 8: 512 x 256).
-        palette: a name from `octax_gym.render.PALETTES` or an (off, on) pair of RGB triples.
+        palette: a name from `octax_gym.render.PALETTES`, an (off, on) pair of RGB triples or
+            four (off, plane 1, plane 2, both: XO-CHIP's colours); None (the default) takes the
+            game's own (`GameSpec.palette`), else "white".
         rom: an explicit ROM path (its SHA-1 must match the game's).
         **env_options: the core env's options (`octax_core.env.config`; None or absent = the
             game's default), all but `autoreset`: frames_per_step, instructions_per_frame,
@@ -81,7 +83,7 @@ class OctaxVectorEnv(gymnasium.vector.VectorEnv):
     def __init__(self, game: Any, num_envs: int = 1, *,
                  autoreset_mode: Union[AutoresetMode, str] = AutoresetMode.NEXT_STEP,
                  backend: str = "numpy", device: Any = None, render_mode: Optional[str] = None,
-                 render_scale: int = render.DEFAULT_RENDER_SCALE, palette: render.PaletteArg = render.DEFAULT_PALETTE,
+                 render_scale: int = render.DEFAULT_RENDER_SCALE, palette: Optional[render.PaletteArg] = None,
                  rom=None, **env_options):
         check_option_names(env_options, KEYWORDS, type(self).__name__)
         self.num_envs = check_int("num_envs", num_envs)
@@ -92,10 +94,13 @@ class OctaxVectorEnv(gymnasium.vector.VectorEnv):
             raise ValueError(f"unknown render_mode {render_mode!r}; valid: None, 'rgb_array'")
         self.render_mode = render_mode
         self.render_scale = render.check_render_scale(render_scale)
-        self.palette = render.resolve_palette(palette)
+        if palette is not None:
+            self.palette = render.resolve_palette(palette)  # a bad one raises before the build
         self._program, params = build(game, rom, env_options)
         self.core_env = self._program.env
         self.game_spec = self.core_env.spec
+        if palette is None:
+            self.palette = render.resolve_palette(self.game_spec.palette or render.DEFAULT_PALETTE)
         self.params = jax.device_put(params, self.device)
         self._step_fn = self._program.step[self.autoreset_mode]
         self._action_check = action_check.DeferredCheck(self.game_spec.id, self.core_env.num_actions, self.device)
@@ -103,7 +108,8 @@ class OctaxVectorEnv(gymnasium.vector.VectorEnv):
         config = self.core_env.config
         self.metadata = {**type(self).metadata, "autoreset_mode": self.autoreset_mode,
                          "render_fps": FRAMES_PER_SECOND / config.frames_per_step}
-        self.single_observation_space = spaces.Box(0, config.obs_scale, self.core_env.observation_shape, np.uint8)
+        self.single_observation_space = spaces.Box(0, self.core_env.observation_high, self.core_env.observation_shape,
+                                                   np.uint8)
         self.single_action_space = spaces.Discrete(self.core_env.num_actions)
         self.observation_space = gymnasium.vector.utils.batch_space(self.single_observation_space, self.num_envs)
         self.action_space = gymnasium.vector.utils.batch_space(self.single_action_space, self.num_envs)
@@ -161,13 +167,14 @@ class OctaxVectorEnv(gymnasium.vector.VectorEnv):
         return out
 
     def render(self) -> Optional[tuple[np.ndarray, ...]]:
-        """One RGB frame per env (H = 32 * render_scale, W = 64 * render_scale), the current screens."""
+        """One RGB frame per env, the current screens: H = 32 * render_scale, W = 64 * render_scale
+        on CHIP-8, twice that on SUPER-CHIP and XO-CHIP (XO-CHIP in the palette's four colours)."""
         if self.render_mode is None:
             gymnasium.logger.warn("render() needs render_mode='rgb_array' at construction; returning None")
             return None
         if self._state is None:
             raise gymnasium.error.ResetNeeded("call reset() before render()")
-        pixels = unpack_screen(np.asarray(self._state.machine.screen))
+        pixels = screen_values(np.asarray(self._state.machine.screen), self.core_env.machine.platform)
         return tuple(render.to_rgb(p, self.render_scale, self.palette) for p in pixels)
 
     def close_extras(self, **kwargs):

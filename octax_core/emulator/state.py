@@ -211,6 +211,23 @@ def unpack_screen(screen, on=True, dtype=jnp.bool_):
     return bits.reshape(*screen.shape[:-1], 32 * screen.shape[-1])
 
 
+def screen_values(screen, platform: Platform, on: int = 1, dtype=jnp.uint8):
+    """Packed screens (leading axes allowed) -> one value per pixel: what an env observes.
+
+    CHIP-8 gives (..., 32, 64) and SUPER-CHIP (..., 64, 128): lit pixels `on` (1 or 255), dark 0.
+    XO-CHIP gives (..., 64, 128) with each pixel's plane combination kept apart, so that its four
+    colours stay four: code = plane 1 + 2 x plane 2 (0 dark, 1 plane 1 only, 2 plane 2 only,
+    3 both), times 85 when `on` is 255 (0, 85, 170, 255). numpy in, numpy out; jittable.
+    """
+    if not platform.extended:
+        return unpack_screen(screen, on=on, dtype=dtype)
+    if platform.planes == 1:
+        return unpack_screen(screen[..., 0, :, :], on=on, dtype=dtype)
+    bits = unpack_screen(screen, on=1, dtype=dtype)
+    codes = bits[..., 0, :, :] + bits[..., 1, :, :] * 2
+    return codes * (on // 3) if on != 1 else codes
+
+
 def snapshot(state: MachineState) -> dict[str, np.ndarray]:
     """The state as a dict of numpy arrays, with the screen unpacked.
 

@@ -28,7 +28,7 @@ import jax.numpy as jnp
 import numpy as np
 
 from octax_core.emulator.machine import Machine
-from octax_core.emulator.state import MachineState, unpack_screen
+from octax_core.emulator.state import MachineState, screen_values, unpack_screen
 from octax_core.env import starts
 from octax_core.env.config import EnvConfig, EnvParams, make_config, make_params
 from octax_core.env.games import GameSpec, get_spec
@@ -50,10 +50,13 @@ class EnvState:
 
 
 class Env:
-    """A CHIP-8 game as a pure, single-env RL environment.
+    """A CHIP-8, SUPER-CHIP or XO-CHIP game as a pure, single-env RL environment.
 
-    Observation: uint8 (frames_per_step, 32, 64), the screen after each frame of the step, lit
-    pixels 1 (or 255 with obs_scale=255). Action: int in 0..num_actions-1; 0 holds no key and
+    Observation: uint8 (frames_per_step, 32, 64) on CHIP-8, (frames_per_step, 64, 128) on
+    SUPER-CHIP and XO-CHIP whatever mode the program is in (a lores pixel is a 2x2 block), the
+    screen after each frame of the step; lit pixels 1 (or 255 with obs_scale=255), and on XO-CHIP
+    one value per plane combination (`octax_core.emulator.state.screen_values`: 0..3, or 0, 85,
+    170, 255; `observation_high` is the largest). Action: int in 0..num_actions-1; 0 holds no key and
     action i holds `spec.action_keys[i - 1]` for the whole step. Reward: change of the game's
     score over the step, float32. Termination: the spec's `terminated_fn`; truncation after
     `params.max_episode_steps` steps. `info`: score, lives (-1 where the game keeps none),
@@ -64,7 +67,7 @@ class Env:
         from octax_core.env.romstore import load_game_rom  # the store does file I/O: only at make
 
         self.spec, self.config = spec, config
-        self.machine = Machine(quirks=spec.quirks, instructions_per_frame=config.instructions_per_frame)
+        self.machine = Machine(spec.platform, quirks=spec.quirks, instructions_per_frame=config.instructions_per_frame)
         template = starts.boot(self.machine, load_game_rom(spec, rom_path), spec.startup)
         noop_step = _noop_stepper(self.machine, config.frames_per_step, config.freeze_timers)
         self._starts = starts.noop_pool(template, noop_step, config.noop_max)
@@ -76,7 +79,14 @@ class Env:
 
     @property
     def observation_shape(self) -> tuple[int, int, int]:
-        return (self.config.frames_per_step, 32, 64)
+        height, width = (64, 128) if self.machine.platform.extended else (32, 64)
+        return (self.config.frames_per_step, height, width)
+
+    @property
+    def observation_high(self) -> int:
+        """The largest observed pixel value: obs_scale, or 3 on XO-CHIP with obs_scale=1."""
+        planes = self.machine.platform.planes
+        return 3 if planes > 1 and self.config.obs_scale == 1 else self.config.obs_scale
 
     @property
     def default_params(self) -> EnvParams:
@@ -112,6 +122,8 @@ class Env:
                                  state.machine, jnp.asarray(self._action_masks)[action], halted=state.done)
         score = self._score(machine)
         terminated = jnp.asarray(self.spec.terminated_fn(machine), jnp.bool_)
+        if machine.exited is not None:  # 00FD: the program has ended, so has the episode
+            terminated = terminated | machine.exited
         episode_step = jnp.where(state.done, state.episode_step, state.episode_step + 1)
         truncated = ~terminated & (episode_step >= params.max_episode_steps)
         reward = jnp.where(state.done, 0.0, score - state.score).astype(jnp.float32)
@@ -156,7 +168,9 @@ class Env:
     # --- pieces -------------------------------------------------------------------------------
 
     def _observe(self, screens) -> jax.Array:
-        return unpack_screen(screens, on=self.config.obs_scale, dtype=jnp.uint8)
+        if not self.machine.platform.extended:
+            return unpack_screen(screens, on=self.config.obs_scale, dtype=jnp.uint8)
+        return screen_values(screens, self.machine.platform, on=self.config.obs_scale)
 
     def _score(self, machine: MachineState) -> jax.Array:
         return jnp.asarray(self.spec.score_fn(machine), jnp.float32)

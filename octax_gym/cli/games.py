@@ -62,6 +62,7 @@ def _cmd_list(args: argparse.Namespace) -> int:
 def _cmd_info(args: argparse.Namespace) -> int:
     from octax_core.env import romstore
     from octax_core.env.environment import EnvConfig
+    from octax_core.emulator.platforms import resolve_platform
     from octax_core.emulator.quirks import resolve_quirks
     from octax_gym.cli.common import lookup_spec
     from octax_gym.registration import env_id
@@ -76,6 +77,9 @@ def _cmd_info(args: argparse.Namespace) -> int:
         return 1
     config = EnvConfig(freeze_timers=spec.freeze_timers)  # what gym.make / make_vec use by default
     quirks = resolve_quirks(spec.quirks)
+    platform = resolve_platform(spec.platform)
+    screen = "64, 128" if platform.extended else "32, 64"
+    high = 3 if platform.planes > 1 else config.obs_scale  # XO-CHIP: one value per plane combination
     status = romstore.rom_status([spec])[0]
     frames, steps_per_second = config.frames_per_step, 60 / config.frames_per_step
     fields = [
@@ -83,8 +87,9 @@ def _cmd_info(args: argparse.Namespace) -> int:
         ("description", spec.description),
         ("actions", f"Discrete({len(spec.action_keys) + 1}); action i holds its key for the whole step"),
         *[("", row) for row in _action_rows(spec.action_keys)],
-        ("observation", (f"Box(0, {config.obs_scale}, ({frames}, 32, 64), uint8), the screen after each frame "
-                         f"of the step; a vector env's is (num_envs, {frames}, 32, 64)")),
+        ("platform", spec.platform),
+        ("observation", (f"Box(0, {high}, ({frames}, {screen}), uint8), the screen after each frame "
+                         f"of the step; a vector env's is (num_envs, {frames}, {screen})")),
         ("step", (f"{frames} frames x {config.instructions_per_frame} instructions "
                   f"({steps_per_second:g} steps per second of game time)")),
         ("quirks", f"{spec.quirks if isinstance(spec.quirks, str) else 'custom'}: "

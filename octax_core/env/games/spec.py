@@ -12,6 +12,7 @@ from typing import Callable, Optional, Union
 import jax
 import jax.numpy as jnp
 
+from octax_core.emulator.platforms import resolve_platform
 from octax_core.emulator.quirks import Quirks
 from octax_core.emulator.state import MachineState
 
@@ -33,7 +34,11 @@ class GameSpec:
         lives_fn: state -> lives left (int32), where the game keeps a count; else None.
         startup: (key mask, frames) pairs run once after boot to get past menus; the resulting
             state is the template every reset starts from.
-        quirks: the interpreter profile this ROM plays correctly under.
+        platform: the machine the ROM is written for: "chip8" (default), "schip" or "xochip".
+        quirks: the interpreter profile this ROM plays correctly under; None (the default) takes
+            the platform's own profile.
+        palette: the game's own colours for rendering, 2 (off, on) or, for XO-CHIP, 4 (off,
+            plane 1, plane 2, both) RGB triples; None uses the renderer's default.
         freeze_timers: zero the delay and sound timers after every env step, as the octax
             package does for most games (its `disable_delay`); off means real 60 Hz timers.
         max_episode_steps: default truncation (env steps of `frames_per_step` frames).
@@ -53,12 +58,17 @@ class GameSpec:
     description: str
     lives_fn: Optional[StateFn] = None
     startup: tuple[tuple[int, int], ...] = ()
-    quirks: Union[str, Quirks] = "chip8"
+    platform: str = "chip8"
+    quirks: Union[str, Quirks, None] = None
+    palette: Optional[tuple[tuple[int, int, int], ...]] = None
     freeze_timers: bool = False
     max_episode_steps: int = 5000
     version: int = 0
 
     def __post_init__(self):
+        platform = resolve_platform(self.platform)  # an unknown name raises, listing the valid ones
+        if self.quirks is None:
+            object.__setattr__(self, "quirks", platform.default_quirks)
         if not self.action_keys or any(not 0 <= k <= 15 for k in self.action_keys):
             raise ValueError(f"{self.id}: action_keys must be CHIP-8 keys 0..15, got {self.action_keys}")
         if len(set(self.action_keys)) != len(self.action_keys):
