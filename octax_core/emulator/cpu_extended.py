@@ -19,7 +19,7 @@ from octax_core.emulator.platforms import Platform
 from octax_core.emulator.quirks import Quirks
 from octax_core.emulator.state import EXTENDED_MIRRORED, MEMORY_OFFSET, MachineState
 
-SPRITE_BYTES = 64  # a 16x16 sprite on two planes
+SPRITE_BYTES = 32  # a 16x16 sprite
 
 _REPLACED = (Kind.CLS, Kind.DRW)
 SCHIP_HANDLERS = {
@@ -98,13 +98,24 @@ def execute(platform: Platform, quirks: Quirks, state: MachineState, keys, stall
     memory = _write_memory(platform, state.memory, cpu.merge(kind, effects, defaults), c)
     # As on CHIP-8, the sprite is read from the written memory: DXYN writes none, so these are
     # its bytes, and the old memory buffer need not stay alive.
-    sprite = jax.lax.dynamic_slice(memory, (c.I + MEMORY_OFFSET,), (SPRITE_BYTES,)).astype(jnp.int32)
     drawing = kind == Kind.DRW
-    mask = planes.sprite_mask(sprite, c.vx, c.vy, fetched.fields.n, c.hires, c.plane, platform.planes,
-                              quirks.clipping, drawing)
+    mask = planes.sprite_mask(_sprite_bytes(platform, memory, c), c.vx, c.vy, fetched.fields.n, c.hires, c.plane,
+                              platform.planes, quirks.clipping, drawing)
     effects[Kind.DRW] = extended.op_dxyn(c._replace(collision=planes.collides(state.screen, mask)))
     effect = cpu.merge(kind, effects, defaults)
     return _apply(platform, state, kind, effects, effect, memory, mask, c), drawing
+
+
+def _sprite_bytes(platform: Platform, memory, c: Context):
+    """(planes, 32) int32: each plane's sprite bytes. Plane 1's start at I; plane 2's follow
+    plane 1's rows when both planes are selected, else they start at I too."""
+    first = jax.lax.dynamic_slice(memory, (c.I + MEMORY_OFFSET,), (SPRITE_BYTES,))
+    if platform.planes == 1:
+        return first[None, :].astype(jnp.int32)
+    wide = c.n == 0
+    size = jnp.where(wide, 32, c.n) * (c.plane & 1)  # plane 1's bytes, when plane 1 is drawn
+    second = jax.lax.dynamic_slice(memory, (c.I + size + MEMORY_OFFSET,), (SPRITE_BYTES,))
+    return jnp.stack([first, second]).astype(jnp.int32)
 
 
 def _write_memory(platform: Platform, memory, effect: Effect, c: Context):

@@ -48,12 +48,16 @@ def place(rows, gx, clipping: bool):
     return words
 
 
-def sprite_mask(sprite, vx, vy, n, hires, plane, planes: int, clipping: bool, drawing):
+def sprite_mask(sprites, vx, vy, n, hires, plane, planes: int, clipping: bool, drawing):
     """The (planes, 64, 4) XOR mask of DXYN on the grid; all zero where `drawing` is false.
 
+    The sprite is built in its own frame first (its rows, doubled in lores, already shifted to
+    their grid column: 32 rows of 4 words), then dropped onto the screen rows with one
+    `dynamic_update_slice`; the rows that fall past the bottom wrap to the top without clipping.
+
     Args:
-        sprite: (64,) int32, the bytes at I..I+63: plane 1's rows, then plane 2's when both
-            planes are selected (a 16x16 sprite is 32 bytes, two a row).
+        sprites: (planes, 32) int32, plane p's 32 bytes from its own start address (plane 1 at
+            I; plane 2 right after plane 1's rows when both are selected, else at I too).
         vx, vy: the registers; taken modulo the screen size of the mode.
         n: the sprite height, 0 meaning 16 rows of 16 pixels.
         hires: bool, 128x64 mode.
@@ -64,27 +68,26 @@ def sprite_mask(sprite, vx, vy, n, hires, plane, planes: int, clipping: bool, dr
     """
     wide = n == 0
     height = jnp.where(wide, 16, n)
-    row_bytes = jnp.where(wide, 2, 1)
-    screen_height = jnp.where(hires, GRID_HEIGHT, GRID_HEIGHT // 2)
+    pairs = sprites.reshape(planes, 16, 2)
+    first = jnp.where(wide, pairs[..., 0], sprites[..., :16])  # (planes, 16): row j's bytes
+    second = jnp.where(wide, pairs[..., 1], 0)
+    selected = ((plane >> jnp.arange(planes, dtype=jnp.int32)) & 1) == 1
+    shown = (jnp.arange(16) < height)[None, :] & selected[:, None] & drawing
+    pattern = jnp.where(shown, (first << 8) | second, 0).astype(jnp.uint32)  # 16 bits, left first
+    # Hires: 16 grid rows of 16 bits. Lores: each row twice, each bit twice: 32 rows of 32 bits.
+    lores = jnp.repeat(double_bits(pattern), 2, axis=-1)
+    hires_rows = jnp.concatenate([pattern << 16, jnp.zeros_like(pattern)], axis=-1)
+    rows = jnp.where(hires, hires_rows, lores)  # (planes, 32)
+    scale = jnp.where(hires, 1, 2)
     x0 = vx & jnp.where(hires, GRID_WIDTH - 1, GRID_WIDTH // 2 - 1)
-    y0 = vy & (screen_height - 1)
-    grid_row = jnp.arange(GRID_HEIGHT, dtype=jnp.int32)
-    offset = jnp.where(hires, grid_row, grid_row >> 1) - y0  # sprite row on each screen row
+    y0 = vy & jnp.where(hires, GRID_HEIGHT - 1, GRID_HEIGHT // 2 - 1)
+    words = place(rows, x0 * scale, clipping)  # (planes, 32, 4)
+    canvas = jnp.zeros((planes, GRID_HEIGHT + 32, WORDS), jnp.uint32)
+    canvas = jax.lax.dynamic_update_slice(canvas, words, (0, y0 * scale, 0))
     if clipping:
-        covered = (offset >= 0) & (offset < height)
-    else:
-        offset = offset & (screen_height - 1)
-        covered = offset < height
-    plane_index = jnp.arange(planes, dtype=jnp.int32)
-    selected = ((plane >> plane_index) & 1) == 1
-    # Plane 2's rows follow plane 1's when plane 1 is drawn too.
-    base = jnp.where(plane_index == 1, (plane & 1) * height * row_bytes, 0)
-    index = jnp.clip(base[:, None] + offset[None, :] * row_bytes, 0, sprite.shape[-1] - 2)
-    first, second = sprite[index], sprite[index + 1]
-    pattern = (first << 8) | jnp.where(wide, second, 0)
-    pattern = jnp.where(covered[None, :] & selected[:, None] & drawing, pattern, 0).astype(jnp.uint32)
-    rows = jnp.where(hires, pattern << 16, double_bits(pattern))
-    return place(rows, jnp.where(hires, x0, 2 * x0), clipping)
+        return canvas[:, :GRID_HEIGHT]
+    wrapped = jnp.concatenate([canvas[:, GRID_HEIGHT:], jnp.zeros_like(canvas[:, 32:GRID_HEIGHT])], axis=1)
+    return canvas[:, :GRID_HEIGHT] | wrapped
 
 
 def collides(screen, mask) -> jax.Array:
@@ -94,14 +97,17 @@ def collides(screen, mask) -> jax.Array:
 
 def scroll(screen, dx, dy):
     """The (planes, 64, 4) planes moved dx grid pixels right and dy down (negative: left, up);
-    what comes in is dark. |dx| < 32, |dy| < 64."""
+    what comes in is dark. |dx| < 32, |dy| < 64.
+
+    Across, a funnel shift of each word with its neighbours (a shift by an out-of-range amount
+    is 0, so the terms of the other direction vanish); down, a take of rows. Measured under
+    vmap on a CPU, this is twice as fast as slicing a zero-padded copy.
+    """
     zero = jnp.zeros_like(screen[..., :1])
     before = jnp.concatenate([zero, screen[..., :-1]], axis=-1)  # the word to the left
     after = jnp.concatenate([screen[..., 1:], zero], axis=-1)  # the word to the right
-    right = _shr(screen, dx) | _shl(before, 32 - dx)
-    left = _shl(screen, -dx) | _shr(after, 32 + dx)
-    moved = jnp.where(dx > 0, right, jnp.where(dx < 0, left, screen))
-    dark = jnp.zeros_like(moved)
-    tall = jnp.concatenate([dark, moved, dark], axis=-2)
-    start = (0,) * (screen.ndim - 2) + (GRID_HEIGHT - dy, 0)
-    return jax.lax.dynamic_slice(tall, start, screen.shape)
+    moved = _shr(screen, dx) | _shl(screen, -dx) | _shl(before, 32 - dx) | _shr(after, 32 + dx)
+    source = jnp.arange(GRID_HEIGHT, dtype=jnp.int32) - dy
+    inside = (source >= 0) & (source < GRID_HEIGHT)
+    rows = jnp.take(moved, jnp.clip(source, 0, GRID_HEIGHT - 1), axis=-2)
+    return jnp.where(inside[:, None], rows, jnp.uint32(0))
