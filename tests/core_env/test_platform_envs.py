@@ -122,3 +122,8 @@ def test_a_game_brings_its_own_palette(tmp_path):
 def test_unknown_platform_in_a_spec(tmp_path):
     with pytest.raises(ValueError, match="unknown platform 'superchip'; valid platforms: 'chip8', 'schip', 'xochip'"):
         tiny_game(tmp_path, "superchip", (0x1200,), b"")
+
+
+def test_the_env_contract_suite_passes_on_xochip(tmp_path):
+    spec, path = xochip_game(tmp_path)
+    octax_core.check_env(spec, rom=path)  # shapes, dtypes, determinism whatever the batch, ...
