@@ -195,3 +195,27 @@ def test_env_loop_usage_errors():
     result = subprocess.run([sys.executable, "benchmarks/env_loop.py", "--layers", "atari"],
                             capture_output=True, text=True, timeout=300, cwd=REPO, check=False)
     assert result.returncode == 2 and "--layers takes env, gym" in result.stderr
+
+
+@pytest.mark.shared
+def test_platforms_prints_one_line_per_platform_with_its_state_bytes(octax_rom_dir):
+    result = subprocess.run(
+        [sys.executable, "benchmarks/platforms.py", "--envs", "2", "--steps", "2", "--repeats", "1"],
+        capture_output=True, text=True, timeout=300, cwd=REPO, check=False)
+    assert result.returncode == 0, result.stderr
+    lines = harness.parse_bench_lines(result.stdout, "platforms")
+    assert [(line["platform"], line["game"]) for line in lines] == [
+        ("chip8", "Pong"), ("schip", "blackrainbow"), ("xochip", "civiliz8n")]
+    assert [int(line["state_bytes"]) for line in lines] == [4508, 5310, 67792]
+    for line in lines:
+        assert int(line["ips"]) == pytest.approx(int(line["sps"]) * 4 * int(line["instructions_per_frame"]), rel=0.01)
+    assert float(lines[0]["ratio"]) > 0 and lines[1]["ratio"] == "na"
+
+
+def test_platforms_usage_errors(tmp_path):
+    result = subprocess.run([sys.executable, "benchmarks/platforms.py", "--platforms", "nes"],
+                            capture_output=True, text=True, timeout=300, cwd=REPO, check=False)
+    assert result.returncode == 2 and "unknown platform(s) ['nes']; valid: chip8, schip, xochip" in result.stderr
+    result = subprocess.run([sys.executable, "benchmarks/platforms.py", "--platforms", "schip", "--archive", str(tmp_path)],
+                            capture_output=True, text=True, timeout=300, cwd=REPO, check=False)
+    assert result.returncode == 1 and "programs.json" in result.stderr
