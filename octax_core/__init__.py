@@ -2,15 +2,16 @@
 
 Three layers, each a subpackage that imports only the ones before it:
 
-* `octax_core.emulator`: the CHIP-8 machine (state pytree, decode, ops, cpu, `Machine`);
+* `octax_core.emulator`: the CHIP-8, SUPER-CHIP and XO-CHIP machines (state pytree, decode, ops,
+  cpu, `Machine`);
 * `octax_core.env`: the game registry, the ROM store and the functional, Gymnax-style env API;
 * `octax_core.tools`: the Octo assembler and disassembler, and the register tracer.
 
 The names below are the public API. See docs/machine.md (the machine) and docs/env.md (the envs).
 """
 
-from octax_core.emulator import (FONT, FONT_ADDRESS, MAX_ROM_SIZE, PROGRAM_ADDRESS, QUIRK_PROFILES, Kind, Machine,
-                                 MachineState, Quirks, Rom, poke, render_text, snapshot)
+from octax_core.emulator import (FONT, FONT_ADDRESS, MAX_ROM_SIZE, PLATFORMS, PROGRAM_ADDRESS, QUIRK_PROFILES, Kind,
+                                 Machine, MachineState, Platform, Quirks, Rom, poke, render_text, snapshot)
 from octax_core.env import (Env, EnvConfig, EnvParams, EnvState, GameSpec, get_spec, list_games, make, make_config,
                             make_params)
 from octax_core.env.testing import check_env
@@ -18,7 +19,8 @@ from octax_core.tools.octo import AssemblyError, assemble
 
 __all__ = [
     "AssemblyError", "FONT", "FONT_ADDRESS", "Env", "EnvConfig", "EnvParams", "EnvState", "GameSpec", "Kind",
-    "MAX_ROM_SIZE", "Machine", "MachineState", "PROGRAM_ADDRESS", "QUIRK_PROFILES", "Quirks", "Rom",
+    "MAX_ROM_SIZE", "Machine", "MachineState", "PLATFORMS", "PROGRAM_ADDRESS", "Platform", "QUIRK_PROFILES",
+    "Quirks", "Rom",
     "assemble", "check_env", "disassemble", "get_spec", "list_games", "make", "make_config", "make_params", "poke",
     "render_text", "snapshot",
 ]

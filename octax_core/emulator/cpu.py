@@ -77,14 +77,18 @@ def fetch(quirks: Quirks, state: MachineState, keys: jax.Array, stalled=None) ->
     window = jax.lax.dynamic_slice(state.memory, (I + MEMORY_OFFSET,), (16,)).astype(jnp.int32)
     fields = decode(opcode[0], opcode[1])
     kind = fields.kind if stalled is None else jnp.where(stalled, int(Kind.STALL), fields.kind)
+    return Fetched(fields, kind, context(quirks, state, fields, pc, I, window, keys))
+
+
+def context(quirks: Quirks, state: MachineState, fields: Decoded, pc, I, window, keys) -> Context:
+    """The handlers' context of every platform: the decoded fields and the registers, as int32."""
     V, sp = state.V.astype(jnp.int32), state.sp.astype(jnp.int32)
-    context = Context(
+    return Context(
         quirks=quirks, x=fields.x, y=fields.y, n=fields.n, nn=fields.nn, nnn=fields.nnn, vx=V[fields.x],
         vy=V[fields.y], v0=V[0], pc=pc, I=I, sp=sp, stack_top=state.stack[(sp - 1) & 0xF].astype(jnp.int32),
         V=V, window=window, collision=jnp.bool_(False), keys=keys,
         delay_timer=state.delay_timer.astype(jnp.int32), rng=state.rng, key_wait=state.key_wait.astype(jnp.int32),
     )
-    return Fetched(fields, kind, context)
 
 
 def merge(kind, effects: dict, defaults: Effect) -> Effect:

@@ -62,12 +62,7 @@ def fetch(platform: Platform, quirks: Quirks, state: MachineState, keys, stalled
     kind = jnp.where(stalled, int(Kind.STALL), fields.kind)
     next_word = (code[2] << 8) | code[3]
     xochip = platform.planes > 1
-    V, sp = state.V.astype(jnp.int32), state.sp.astype(jnp.int32)
-    context = Context(
-        quirks=quirks, x=fields.x, y=fields.y, n=fields.n, nn=fields.nn, nnn=fields.nnn, vx=V[fields.x],
-        vy=V[fields.y], v0=V[0], pc=pc, I=I, sp=sp, stack_top=state.stack[(sp - 1) & 0xF].astype(jnp.int32),
-        V=V, window=window, collision=jnp.bool_(False), keys=keys,
-        delay_timer=state.delay_timer.astype(jnp.int32), rng=state.rng, key_wait=state.key_wait.astype(jnp.int32),
+    context = cpu.context(quirks, state, fields, pc, I, window, keys)._replace(
         # A skip jumps over a whole instruction: 4 bytes when it is XO-CHIP's F000 NNNN.
         skip_bytes=jnp.where(next_word == 0xF000, 4, 2) if xochip else None,
         next_word=next_word, hires=state.hires, flags=state.flags.astype(jnp.int32),

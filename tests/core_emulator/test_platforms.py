@@ -86,13 +86,13 @@ def test_hand_programs_match_reference(name, platform, quirks, words, data, coun
     assert lit == any(0xD000 <= w < 0xE000 for w in words), "a program that draws must light pixels"
 
 
-def test_scrolls_move_what_the_contract_says():
+def test_scrolls_move_what_the_contract_says(jit_execute):
     # hires: one pixel at (8, 8); down 3, right 4 -> (12, 11); lores: the 2x2 block moves twice as far
     for prefix, scale in ((0x00FF, 1), (0x00FE, 2)):
         machine = octax_core.Machine("schip")
         state = machine.boot(assemble(prefix, 0x6008, 0xA20E, 0xD001, 0x00C3, 0x00FB, 0x1210) + b"\x80", jax.random.key(0))
         for _ in range(6):
-            state = machine.execute(state, 0)
+            state = jit_execute(machine)(state, 0)
         lit = set(zip(*np.nonzero(octax_core.snapshot(state)["screen"])))
         assert lit == {(11 * scale + j, 12 * scale + i) for i in range(scale) for j in range(scale)}
 
@@ -131,13 +131,13 @@ def test_rom_too_large_for_its_platform_names_both_sizes():
         octax_core.Rom(bytes(65025))
 
 
-def test_xochip_opcodes_are_no_ops_on_chip8():
+def test_xochip_opcodes_are_no_ops_on_chip8(jit_execute):
     # F000 NNNN is a 2-byte no-op (its address word then runs as an instruction: 6042)
     machine = octax_core.Machine("chip8")
     state = machine.boot(assemble(0xF000, 0x6042, 0x5012, 0x00FF, 0xF101), jax.random.key(0))
     before = octax_core.snapshot(state)
     for step in range(5):
-        state = machine.execute(state, 0)
+        state = jit_execute(machine)(state, 0)
     after = octax_core.snapshot(state)
     assert int(after["pc"]) == START + 10 and int(after["V"][0]) == 0x42 and int(after["I"]) == 0
     assert np.array_equal(before["memory"], after["memory"]) and not after["screen"].any()

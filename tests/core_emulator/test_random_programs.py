@@ -119,6 +119,11 @@ def boot_both(rom, quirks, seed):
        seed=st.integers(0, 2**32 - 1))
 def test_instructions_match_reference(quirk_set, rom, keys, seed):
     machine, state, ref = boot_both(rom, QUIRK_SETS[quirk_set], seed)
+    assert_instructions_match(quirk_set, machine, state, ref, keys, rom)
+
+
+def assert_instructions_match(label, machine, state, ref, keys, rom):
+    """Runs one instruction per key mask on both machines; every snapshot must match."""
     states = octax_core.snapshot(jitted_trace(machine)(state, np.asarray(keys, np.int32)))
     for step, mask in enumerate(keys):
         pc = ref.pc
@@ -126,8 +131,20 @@ def test_instructions_match_reference(quirk_set, rom, keys, seed):
         got = {name: value[step] for name, value in states.items()}
         difference = first_difference(ref.snapshot(), got)
         assert difference is None, (
-            f"[{quirk_set}] instruction {step}, pc={pc:#05x} opcode={opcode:04X}, keys={mask:#06x}: "
+            f"[{label}] instruction {step}, pc={pc:#06x} opcode={opcode:04X}, keys={mask:#06x}: "
             f"{difference}\n  program: {listing(rom)}")
+
+
+def assert_frames_match(label, run, state, ref, keys, rom):
+    """Runs one frame per key mask on both machines; every snapshot must match."""
+    for frame, mask in enumerate(keys):
+        pc = ref.pc
+        ref.run_frame(mask)
+        state = run(state, mask, 1)
+        difference = first_difference(ref.snapshot(), octax_core.snapshot(state))
+        assert difference is None, (
+            f"[{label}] frame {frame} from pc={pc:#06x}, keys={mask:#06x}: {difference}\n"
+            f"  program: {listing(rom)}")
 
 
 @pytest.mark.parametrize("quirk_set", QUIRK_SETS)
@@ -136,12 +153,4 @@ def test_instructions_match_reference(quirk_set, rom, keys, seed):
        seed=st.integers(0, 2**32 - 1))
 def test_frames_match_reference(quirk_set, rom, keys, seed, jit_run_frames):
     machine, state, ref = boot_both(rom, QUIRK_SETS[quirk_set], seed)
-    run = jit_run_frames(machine)
-    for frame, mask in enumerate(keys):
-        pc = ref.pc
-        ref.run_frame(mask)
-        state = run(state, mask, 1)
-        difference = first_difference(ref.snapshot(), octax_core.snapshot(state))
-        assert difference is None, (
-            f"[{quirk_set}] frame {frame} from pc={pc:#05x}, keys={mask:#06x}: {difference}\n"
-            f"  program: {listing(rom)}")
+    assert_frames_match(quirk_set, jit_run_frames(machine), state, ref, keys, rom)

@@ -9,12 +9,12 @@ under its own quirk profile and under a mix that the profile does not cover.
 """
 
 import jax
-import numpy as np
 import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from reference import RefMachine, first_difference
-from test_random_programs import address, byte, common, jitted_trace, key_mask, listing, nibble, xnn, xyn
+from test_random_programs import (address, assert_frames_match, assert_instructions_match, byte, common, key_mask,
+                                  nibble, xnn, xyn)
 
 import octax_core
 
@@ -94,15 +94,7 @@ def case_programs(case):
 def test_instructions_match_reference(case, data, keys, seed):
     rom = data.draw(case_programs(case), label="rom")
     machine, state, ref = boot_both(rom, case, seed)
-    states = octax_core.snapshot(jitted_trace(machine)(state, np.asarray(keys, np.int32)))
-    for step, mask in enumerate(keys):
-        pc = ref.pc
-        opcode = ref.execute(mask)
-        got = {name: value[step] for name, value in states.items()}
-        difference = first_difference(ref.snapshot(), got)
-        assert difference is None, (
-            f"[{case}] instruction {step}, pc={pc:#06x} opcode={opcode:04X}, keys={mask:#06x}: "
-            f"{difference}\n  program: {listing(rom)}")
+    assert_instructions_match(case, machine, state, ref, keys, rom)
 
 
 @pytest.mark.parametrize("case", CASES)
@@ -111,12 +103,4 @@ def test_instructions_match_reference(case, data, keys, seed):
 def test_frames_match_reference(case, data, keys, seed, jit_run_frames):
     rom = data.draw(case_programs(case), label="rom")
     machine, state, ref = boot_both(rom, case, seed)
-    run = jit_run_frames(machine)
-    for frame, mask in enumerate(keys):
-        pc = ref.pc
-        ref.run_frame(mask)
-        state = run(state, mask, 1)
-        difference = first_difference(ref.snapshot(), octax_core.snapshot(state))
-        assert difference is None, (
-            f"[{case}] frame {frame} from pc={pc:#06x}, keys={mask:#06x}: {difference}\n"
-            f"  program: {listing(rom)}")
+    assert_frames_match(case, jit_run_frames(machine), state, ref, keys, rom)
