@@ -71,10 +71,9 @@ class Machine:
         return boot_state(rom, key, self.platform)
 
     def execute(self, state: MachineState, keys) -> MachineState:
-        """Runs exactly one instruction (no timer tick, no display wait)."""
+        """Runs exactly one instruction (no timer tick, no display wait; after 00FD, nothing)."""
         if self.platform.extended:
-            new_state, _ = cpu_extended.execute(self.platform, self.quirks, state, keys_to_mask(keys),
-                                                jnp.zeros((), jnp.bool_) | state.exited)
+            new_state, _ = cpu_extended.execute(self.platform, self.quirks, state, keys_to_mask(keys), state.exited)
         else:
             new_state, _ = cpu.execute(self.quirks, state, keys_to_mask(keys))
         return new_state

@@ -142,9 +142,14 @@ def platform_of(state: "MachineState") -> Platform:
 
 
 def ram_size(memory) -> int:
-    """The RAM size inside a stored memory of this length (leading axes allowed)."""
+    """The RAM size inside a stored memory (leading axes allowed): each platform's stored length
+    is its own (`stored_memory_size`)."""
     length = memory.shape[-1]
-    return length - MEMORY_OFFSET - (MIRROR_SIZE if length == STORED_MEMORY_SIZE else EXTENDED_MIRROR_SIZE)
+    for platform in PLATFORMS.values():
+        if stored_memory_size(platform) == length:
+            return platform.memory_size
+    known = ", ".join(f"{stored_memory_size(p)} ({p.name})" for p in PLATFORMS.values())
+    raise ValueError(f"a stored memory of {length} bytes belongs to no platform; the lengths are {known}")
 
 
 def ram_view(memory):
