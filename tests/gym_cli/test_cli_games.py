@@ -86,7 +86,7 @@ def test_info_pong_shows_ids_actions_spaces_and_rom(octax_rom_dir, capsys):
     actions = lines.index("actions:           Discrete(3); action i holds its key for the whole step")
     assert [line.split() for line in lines[actions + 1:actions + 4]] == [
         ["0", "no", "key"], ["1", "CHIP-8", "key", "1"], ["2", "CHIP-8", "key", "4"]]
-    for expected in ("category:          timing", "Box(0, 1, (4, 32, 64), uint8)",
+    for expected in ("category:          timing", "platform:          chip8", "Box(0, 1, (4, 32, 64), uint8)",
                      "quirks:            chip8: vf_reset=True", "timers:            real, 60 Hz",
                      "max_episode_steps: 4500", "lives:             no: info['lives'] is -1",
                      "rom:               Pong (1 player).ch8",
@@ -110,6 +110,15 @@ def test_info_shows_lives_frozen_timers_and_startup_keys(capsys):
     assert "lives:             yes: info['lives'] counts them" in capsys.readouterr().out
     cli.main(["info", "VerticalBrix"])  # starts by holding key 7 for 250 frames
     assert "startup:           250 frames holding key 7, then 1 frame (no key)" in capsys.readouterr().out
+
+
+def test_info_shows_an_xochip_game_s_platform_and_observation(monkeypatch, capsys):
+    xochip = dataclasses.replace(get_spec("Pong"), platform="xochip", quirks=None)  # no registered game is one yet
+    monkeypatch.setattr(cli_common, "lookup_spec", lambda name: xochip)
+    assert cli.main(["info", "Pong"]) == 0
+    out = capsys.readouterr().out
+    for expected in ("platform:          xochip", "Box(0, 3, (4, 64, 128), uint8)", "quirks:            xochip: vf_reset=False"):
+        assert expected in out, expected
 
 
 def test_info_shows_frozen_timers(monkeypatch, capsys):
