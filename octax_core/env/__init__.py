@@ -9,7 +9,7 @@ See docs/env.md.
 
 from octax_core.env.config import ENV_OPTIONS, EnvConfig, EnvParams, make_config, make_params
 from octax_core.env.environment import Env, EnvState, make
-from octax_core.env.games import GameSpec, get_spec, list_games
+from octax_core.env.games import SUITES, GameSpec, get_spec, list_games, suite_of
 
-__all__ = ["ENV_OPTIONS", "Env", "EnvConfig", "EnvParams", "EnvState", "GameSpec", "get_spec", "list_games", "make",
-           "make_config", "make_params"]
+__all__ = ["ENV_OPTIONS", "Env", "EnvConfig", "EnvParams", "EnvState", "GameSpec", "SUITES", "get_spec", "list_games",
+           "make", "make_config", "make_params", "suite_of"]

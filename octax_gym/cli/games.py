@@ -3,7 +3,7 @@
 Nothing is emulated: both commands read `GameSpec`s, the `EnvConfig` defaults and the ROM store
 (hashing the small ROM files), so they answer in about the time it takes to import JAX.
 
-    octax-gym list [--category timing]       every game: Gymnasium id, category, actions, ROM
+    octax-gym list [--category timing] [--suite ours]   every game: Gymnasium id, category, actions, ROM
     octax-gym info Pong                      one game in full (also `info octax/Pong-v0`)
 """
 
@@ -22,6 +22,7 @@ def add_commands(commands: argparse._SubParsersAction) -> None:
                                             "present and verified.")
     games.add_argument("--category", help="only this category (planning, timing, resources, "
                                           "navigation, reaction)")
+    games.add_argument("--suite", help="only this suite (octax: the paper's games; ours: Dodge, Flak)")
     games.set_defaults(func=_cmd_list)
     info = commands.add_parser("info", help="one game: actions, spaces, quirks, timers, ROM",
                                description="Everything a game's spec says, without running it.")
@@ -31,11 +32,14 @@ def add_commands(commands: argparse._SubParsersAction) -> None:
 
 def _cmd_list(args: argparse.Namespace) -> int:
     from octax_core.env import romstore
-    from octax_core.env.games import CATEGORIES
-    from octax_gym.cli.common import game_specs, print_table
+    from octax_core.env.games import CATEGORIES, SUITES, get_spec, list_games
+    from octax_gym.cli.common import print_table
     from octax_gym.registration import env_id
 
-    specs = game_specs()
+    if args.suite is not None and args.suite not in SUITES:
+        print(f"octax-gym list: error: unknown suite {args.suite!r}; valid: {', '.join(SUITES)}", file=sys.stderr)
+        return 2
+    specs = [get_spec(game) for game in list_games(args.suite)]
     if args.category is not None:
         if args.category.lower() not in CATEGORIES:
             print(f"octax-gym list: error: unknown category {args.category!r}; valid: {', '.join(CATEGORIES)}",

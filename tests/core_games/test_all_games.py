@@ -29,6 +29,19 @@ def test_registry_holds_exactly_the_suite():
     assert octax_core.list_games() == EXPECTED_IDS
 
 
+def test_suites_split_the_registry():
+    from octax_core.env import SUITES, suite_of
+
+    assert octax_core.list_games(suite="octax") == sorted(PAPER_IDS)
+    assert octax_core.list_games(suite="ours") == OWN_IDS
+    assert sorted(octax_core.list_games(suite) for suite in SUITES) == sorted([sorted(PAPER_IDS), OWN_IDS])
+    assert suite_of("Pong") == "octax" and suite_of("Flak2") == "ours"
+    with pytest.raises(ValueError, match="unknown suite 'atari'; valid suites: 'octax', 'ours'"):
+        octax_core.list_games(suite="atari")
+    with pytest.raises(KeyError, match="unknown game 'Pacman'"):
+        suite_of("Pacman")
+
+
 def test_specs_are_complete():
     for game_id in EXPECTED_IDS:
         spec = octax_core.get_spec(game_id)

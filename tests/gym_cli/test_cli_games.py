@@ -70,6 +70,15 @@ def test_list_category_filter_keeps_exactly_that_category(category, capsys):
     assert {row[1] for row in rows.values()} == {category}
 
 
+def test_list_suite_filter(capsys):
+    assert cli.main(["list", "--suite", "ours", "--category", "reaction"]) == 0
+    rows = _rows(capsys.readouterr().out)
+    assert list(rows) == [env_id(g) for g in list_games(suite="ours") if get_spec(g).category == "reaction"] != []
+    assert cli.main(["list", "--suite", "nes"]) == 2
+    captured = capsys.readouterr()
+    assert captured.out == "" and "unknown suite 'nes'; valid: octax, ours" in captured.err
+
+
 def test_list_unknown_category_is_a_usage_error_naming_the_valid_ones(capsys):
     assert cli.main(["list", "--category", "arcade"]) == 2
     captured = capsys.readouterr()

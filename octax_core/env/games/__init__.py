@@ -1,37 +1,65 @@
 """The game registry: every module in this package exports `SPECS`, a tuple of `GameSpec`.
 
-Modules are discovered, not listed, so adding a game is adding one module. Lookups raise errors
-that name the valid ids.
+Modules are discovered, not listed, so adding a game is adding one module. A module may name its
+suite (`SUITE = "ours"`); without one its games are the octax paper's. Lookups raise errors that
+name the valid ids (or suites).
 """
 
 from __future__ import annotations
 
 import importlib
 import pkgutil
+from typing import Optional
 
 from octax_core.env.games.spec import CATEGORIES, GameSpec, key_mask
 
+SUITES = {
+    "octax": "the octax paper's suite: 21 classic CHIP-8 titles and their levels",
+    "ours": "octax-gym's own games, written in Octo (roms/*.8o): Dodge and Flak, by level",
+}
 _REGISTRY: dict[str, GameSpec] = {}
+_SUITE_OF: dict[str, str] = {}
 
 
-def register(spec: GameSpec) -> None:
-    """Adds a game; ids are unique (as in gymnax's registry)."""
+def register(spec: GameSpec, suite: str = "octax") -> None:
+    """Adds a game to a suite; ids are unique (as in gymnax's registry)."""
+    _check_suite(suite)
     if spec.id in _REGISTRY:
         raise ValueError(f"game {spec.id!r} is already registered")
     _REGISTRY[spec.id] = spec
+    _SUITE_OF[spec.id] = suite
+
+
+def _check_suite(suite: str) -> None:
+    if suite not in SUITES:
+        raise ValueError(f"unknown suite {suite!r}; valid suites: {', '.join(repr(s) for s in SUITES)}")
 
 
 def _discover() -> None:
     for module in sorted(pkgutil.iter_modules(__path__), key=lambda m: m.name):
         if module.name == "spec" or module.name.startswith("_"):
             continue
-        for spec in importlib.import_module(f"{__name__}.{module.name}").SPECS:
-            register(spec)
+        games = importlib.import_module(f"{__name__}.{module.name}")
+        for spec in games.SPECS:
+            register(spec, getattr(games, "SUITE", "octax"))
 
 
-def list_games() -> list[str]:
-    """Ids of every registered game, sorted."""
-    return sorted(_REGISTRY)
+def list_games(suite: Optional[str] = None) -> list[str]:
+    """Ids of the registered games of `suite` (every game when None), sorted.
+
+    Raises:
+        ValueError: an unknown suite; the message lists the valid ones (`SUITES`).
+    """
+    if suite is None:
+        return sorted(_REGISTRY)
+    _check_suite(suite)
+    return sorted(game for game, its_suite in _SUITE_OF.items() if its_suite == suite)
+
+
+def suite_of(game_id: str) -> str:
+    """The suite a registered game belongs to (KeyError for an unknown id, as `get_spec`)."""
+    get_spec(game_id)
+    return _SUITE_OF[game_id]
 
 
 def get_spec(game_id: str) -> GameSpec:
@@ -48,4 +76,4 @@ def get_spec(game_id: str) -> GameSpec:
 
 _discover()
 
-__all__ = ["CATEGORIES", "GameSpec", "get_spec", "key_mask", "list_games", "register"]
+__all__ = ["CATEGORIES", "GameSpec", "SUITES", "get_spec", "key_mask", "list_games", "register", "suite_of"]

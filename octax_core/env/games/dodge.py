@@ -58,4 +58,5 @@ def _spec(game_id: str, level: int, rocks: int, fall: int):
     )
 
 
+SUITE = "ours"
 SPECS = level_specs("Dodge", _LEVELS, DEFAULT_LEVEL, _spec)

@@ -63,4 +63,5 @@ def _spec(game_id: str, level: int, planes: int, speed: int):
     )
 
 
+SUITE = "ours"
 SPECS = level_specs("Flak", _LEVELS, DEFAULT_LEVEL, _spec)
