@@ -6,7 +6,8 @@ machine` does for Pong), best of `--repeats` timed runs, compile time excluded:
 
     chip8   Pong (the octax suite's ROM, from the ROM store), 11 instructions a frame, as the
             octax paper measures it; octax runs the same work, and the ratio is reported
-    schip   a hires SUPER-CHIP game of the Chip8 Community Archive (default blackrainbow)
+    schip   a hires SUPER-CHIP game of the Chip8 Community Archive, which ships in the package
+            (octax_core/env/roms/archive/; default blackrainbow)
     xochip  a hires XO-CHIP game of the archive (default civiliz8n)
 
 The archive games run under their own programs.json quirks and tick rate (instructions a frame),
@@ -27,13 +28,16 @@ from pathlib import Path
 from typing import Optional
 
 import octax_side
-from harness import (REPO_ROOT, BenchError, Prepared, Progress, bench_line, compile_rollout, find_rom, load_average,
+from harness import (BenchError, Prepared, Progress, bench_line, compile_rollout, find_rom, load_average,
                      machine_line, state_bytes, time_interleaved)
 
 PLATFORMS = ("chip8", "schip", "xochip")
 FRAMES_PER_STEP = 4
 CHIP8_GAME, CHIP8_INSTRUCTIONS_PER_FRAME = "Pong", 11
-DEFAULT_ARCHIVE = REPO_ROOT.parent / "shared" / "roms" / "chip8archive"
+def _packaged_archive() -> Path:
+    from octax_core.env.romstore import ARCHIVE_ROM_DIR  # the archive ships in the package
+
+    return ARCHIVE_ROM_DIR
 DEFAULT_GAMES = {"schip": "blackrainbow", "xochip": "civiliz8n"}
 
 
@@ -46,8 +50,8 @@ def main(argv: Optional[list[str]] = None) -> int:
     parser.add_argument("--key", type=int, default=-1, help="CHIP-8 key held throughout, -1 for none (default)")
     parser.add_argument("--schip-game", default=DEFAULT_GAMES["schip"], help="archive program name for schip")
     parser.add_argument("--xochip-game", default=DEFAULT_GAMES["xochip"], help="archive program name for xochip")
-    parser.add_argument("--archive", type=Path, default=DEFAULT_ARCHIVE,
-                        help="folder with the archive's ROMs and programs.json (default ../shared/roms/chip8archive)")
+    parser.add_argument("--archive", type=Path, default=None,
+                        help="folder with the archive's ROMs and programs.json (default: the package's copy)")
     parser.add_argument("--no-octax", action="store_true", help="skip the octax comparison on chip8")
     args = parser.parse_args(argv)
     try:
@@ -60,6 +64,7 @@ def main(argv: Optional[list[str]] = None) -> int:
     if unknown := [p for p in args.platforms if p not in PLATFORMS]:
         parser.error(f"unknown platform(s) {unknown}; valid: {', '.join(PLATFORMS)}")
     args.devices = 1  # octax_side reads it
+    args.archive = args.archive or _packaged_archive()
     try:
         return run(args)
     except (BenchError, FileNotFoundError, KeyError) as exc:

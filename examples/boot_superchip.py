@@ -3,8 +3,9 @@
     python examples/boot_superchip.py                    # a tiny program written here: big "8", scrolled
     python examples/boot_superchip.py GAME.ch8 xochip    # any ROM, platform schip (default) or xochip
 
-The Chip8 Community Archive's SUPER-CHIP and XO-CHIP games (../shared/roms/chip8archive on our
-machines) run this way; each wants its own quirks and tick rate, which programs.json lists
+The Chip8 Community Archive's SUPER-CHIP and XO-CHIP games run this way; they ship in the package
+(`octax_core.env.romstore.ARCHIVE_ROM_DIR`: e.g. blackrainbow.ch8 schip, civiliz8n.ch8 xochip),
+and each wants its own quirks and tick rate, which the programs.json beside them lists
 (`octax_core.emulator.quirks.quirks_from_octo` reads its flags).
 """
 

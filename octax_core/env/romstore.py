@@ -1,13 +1,16 @@
 """The ROM store: find, verify and install the ROM each game names by SHA-1.
 
-Third-party ROMs are never committed, so a game's `GameSpec` carries only a file name and the
-SHA-1 of the bytes it was written against. Lookup order (the first file found decides):
+The octax suite's ROMs are never committed, so a game's `GameSpec` carries only a file name and
+the SHA-1 of the bytes it was written against. Lookup order (the first file found decides):
 
 1. an explicit path given by the caller;
 2. each folder in `OCTAX_ROM_DIR` (an `os.pathsep`-separated list; relative entries are taken
    from the current directory);
 3. the user data folder, `user_rom_dir()`;
-4. the project's own `roms/` folder, when it exists (our games, built from `.8o` source).
+4. the ROMs that ship inside the package, `PROJECT_ROM_DIR` (octax_core/env/roms/): our own games
+   (links to roms/*.ch8, built from `.8o` source) and, in `archive/`, the Chip8 Community
+   Archive's CC0 programs (`ARCHIVE_ROM_DIR`, with their programs.json and LICENSE.md). A wheel
+   carries them as package data, so they are there wherever the package is installed.
 
 A file whose hash differs is refused with `RomHashError`, never loaded and never skipped for a
 later folder: a corrupted or edited ROM would silently change the game. `import_roms` and
@@ -31,7 +34,8 @@ from octax_core.emulator.rom import Rom
 
 PathLike = Union[str, os.PathLike]
 
-PROJECT_ROM_DIR = Path(__file__).resolve().parents[2] / "roms"
+PROJECT_ROM_DIR = Path(__file__).resolve().parent / "roms"
+ARCHIVE_ROM_DIR = PROJECT_ROM_DIR / "archive"
 FIX_HINT = (
     "run `octax-gym roms install` (gets the octax==0.1.1 wheel from PyPI and installs its ROMs), "
     "or `octax-gym roms import PATH` (a folder, zip or wheel you have), "

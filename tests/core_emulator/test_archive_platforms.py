@@ -14,22 +14,17 @@ import json
 import jax
 import pytest
 from reference import RefMachine, first_difference
-from shared_data import SHARED
 
 import octax_core
 from octax_core.emulator.quirks import quirks_from_octo
+from octax_core.env.romstore import ARCHIVE_ROM_DIR as ARCHIVE  # the archive ships in the package
 
-ARCHIVE = SHARED / "roms" / "chip8archive"
 FRAMES = 120  # per program; programs that run 10,000 instructions a frame get a tenth
 
 
 def archive_programs() -> dict:
-    """The archive's SUPER-CHIP and XO-CHIP entries by name (a placeholder without ../shared,
-    which the `shared` mark then skips, or fails under OCTAX_REQUIRE_SHARED=1)."""
-    path = ARCHIVE / "programs.json"
-    if not path.is_file():
-        return {"<needs ../shared>": None}
-    programs = json.loads(path.read_text())
+    """The archive's SUPER-CHIP and XO-CHIP entries by name."""
+    programs = json.loads((ARCHIVE / "programs.json").read_text())
     return {name: entry for name, entry in programs.items() if entry["platform"] in ("schip", "xochip")}
 
 
@@ -41,13 +36,11 @@ def keys_at(frame: int) -> int:
     return 1 << (hold // 2 % 16) if hold % 2 else 0
 
 
-@pytest.mark.shared
 def test_the_archive_has_its_53_modern_programs():
     assert len(PROGRAMS) == 53
     assert sorted({entry["platform"] for entry in PROGRAMS.values()}) == ["schip", "xochip"]
 
 
-@pytest.mark.shared
 @pytest.mark.parametrize("name", PROGRAMS)
 def test_program_matches_reference_frame_by_frame(name, jit_run_frames):
     entry = PROGRAMS[name]

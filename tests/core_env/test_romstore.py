@@ -74,9 +74,12 @@ def test_search_dirs_order_env_list_then_user_then_project(tmp_path, monkeypatch
     ]
 
 
-def test_real_project_roms_dir_is_the_repository_roms_folder():
+def test_real_project_roms_dir_is_the_package_roms_folder_whose_own_roms_are_the_repository_s():
     assert REAL_PROJECT_ROM_DIR.name == "roms"
-    assert (REAL_PROJECT_ROM_DIR.parent / "octax_core" / "env" / "romstore.py").is_file()
+    assert (REAL_PROJECT_ROM_DIR.parent / "romstore.py").is_file()
+    repository_roms = REAL_PROJECT_ROM_DIR.parents[2] / "roms"
+    for name in ("dodge.ch8", "flak.ch8"):  # links into roms/, where the Octo sources build them
+        assert (REAL_PROJECT_ROM_DIR / name).resolve() == (repository_roms / name).resolve()
 
 
 @pytest.mark.parametrize("holders, winner", [

@@ -36,7 +36,8 @@ def test_specs_name_the_committed_rom_by_hash(source):
 
 
 def test_the_rom_store_finds_our_roms_in_the_project():
-    assert PROJECT_ROM_DIR == ROMS
+    for name in ("dodge.ch8", "flak.ch8"):  # the package's copies are links to roms/
+        assert (PROJECT_ROM_DIR / name).read_bytes() == (ROMS / name).read_bytes()
     for game_id in ("Dodge", "Flak"):
         spec = octax_core.get_spec(game_id)
         assert find_rom(spec).name == spec.rom_file

@@ -1,0 +1,53 @@
+"""The ROMs that ship inside the package (octax_core/env/roms/): our own games and the Chip8
+Community Archive's CC0 programs. A wheel carries them, so a `pip install` has them without the
+ROM store's download; the archive's files are unchanged and credited."""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import subprocess
+import sys
+import zipfile
+from pathlib import Path
+
+from octax_core.env.romstore import ARCHIVE_ROM_DIR, PROJECT_ROM_DIR
+
+REPO = Path(__file__).resolve().parents[2]
+
+
+def archive_programs() -> dict:
+    return json.loads((ARCHIVE_ROM_DIR / "programs.json").read_text())
+
+
+def test_every_archive_program_is_there_unchanged():
+    programs = archive_programs()
+    sums = dict(reversed(line.split()) for line in (ARCHIVE_ROM_DIR / "SHA1SUMS").read_text().splitlines() if line)
+    assert len(programs) == 101 and sorted(sums) == sorted(f"{name}.ch8" for name in programs)
+    for file, sha1 in sums.items():
+        assert hashlib.sha1((ARCHIVE_ROM_DIR / file).read_bytes()).hexdigest() == sha1, file
+    assert sorted(p.name for p in ARCHIVE_ROM_DIR.glob("*.ch8")) == sorted(sums)
+    platforms = sorted(entry["platform"] for entry in programs.values())
+    assert (platforms.count("chip8"), platforms.count("schip"), platforms.count("xochip")) == (48, 25, 28)
+
+
+def test_the_licence_note_says_cc0_and_credits_every_program():
+    note = (ARCHIVE_ROM_DIR / "LICENSE.md").read_text()
+    assert "Creative Commons Zero" in note and "0a41cc23ad5c" in note
+    for name, entry in archive_programs().items():
+        row = next(line for line in note.splitlines() if line.startswith(f"| {name} |"))
+        assert all(author in row for author in entry["authors"]) and entry["platform"] in row
+
+
+def test_a_wheel_ships_our_roms_and_the_archive(tmp_path):
+    """Built from this checkout (setuptools, no network); the fix for wheels that lacked Dodge and Flak."""
+    result = subprocess.run([sys.executable, "-m", "pip", "wheel", str(REPO), "--no-deps", "--no-build-isolation",
+                             "-q", "-w", str(tmp_path)], capture_output=True, text=True, timeout=300, check=False)
+    assert result.returncode == 0, result.stderr
+    (wheel,) = tmp_path.glob("octax_gym-*.whl")
+    with zipfile.ZipFile(wheel) as archive:
+        names = set(archive.namelist())
+        for name in ("dodge.ch8", "flak.ch8"):
+            assert archive.read(f"octax_core/env/roms/{name}") == (PROJECT_ROM_DIR / name).read_bytes()
+        shipped = {Path(n).name for n in names if n.startswith("octax_core/env/roms/archive/")}
+    assert shipped == {p.name for p in ARCHIVE_ROM_DIR.iterdir()}
