@@ -187,7 +187,11 @@ def test_env_loop_prints_one_line_per_case_against_the_machine_and_octax():
     assert [(line["layer"], line["noop_max"]) for line in lines] == [("env", "0"), ("env", "3"), ("gym", "0"), ("gym", "3")]
     for line in lines:
         assert (line["autoreset"], line["sticky"], line["max_episode_steps"]) == ("1", "0.25", "1")
-        assert float(line["vs_machine"]) == pytest.approx(int(line["sps"]) / int(line["machine_sps"]), abs=0.002)
+        # vs_machine comes from the unrounded rates; the line's rates are rounded to integers, which
+        # at these tiny runs moves their ratio by up to half a unit of each.
+        sps, machine_sps = int(line["sps"]), int(line["machine_sps"])
+        low, high = (sps - 0.5) / (machine_sps + 0.5), (sps + 0.5) / max(machine_sps - 0.5, 0.5)
+        assert low - 0.0005 <= float(line["vs_machine"]) <= high + 0.0005, line
         assert int(line["octax_sps"]) > 0 and float(line["ratio"]) > 0
 
 
