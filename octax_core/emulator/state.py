@@ -233,6 +233,16 @@ def screen_values(screen, platform: Platform, on: int = 1, dtype=jnp.uint8):
     return codes * (on // 3) if on != 1 else codes
 
 
+def screen_values_shape(platform: Platform) -> tuple[int, int]:
+    """The (height, width) `screen_values` gives: (32, 64) on CHIP-8, (64, 128) after it."""
+    return (GRID_HEIGHT, GRID_WIDTH) if platform.extended else (SCREEN_HEIGHT, SCREEN_WIDTH)
+
+
+def screen_values_max(platform: Platform, on: int = 1) -> int:
+    """The largest value `screen_values` gives: `on`, or 3 on XO-CHIP with on = 1 (its plane codes)."""
+    return 3 if platform.planes > 1 and on == 1 else on
+
+
 def snapshot(state: MachineState) -> dict[str, np.ndarray]:
     """The state as a dict of numpy arrays, with the screen unpacked.
 

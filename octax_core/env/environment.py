@@ -28,7 +28,8 @@ import jax.numpy as jnp
 import numpy as np
 
 from octax_core.emulator.machine import Machine
-from octax_core.emulator.state import MachineState, screen_values, unpack_screen
+from octax_core.emulator.state import (MachineState, screen_values, screen_values_max, screen_values_shape,
+                                       unpack_screen)
 from octax_core.env import starts
 from octax_core.env.config import EnvConfig, EnvParams, make_config, make_params
 from octax_core.env.games import GameSpec, get_spec
@@ -79,14 +80,12 @@ class Env:
 
     @property
     def observation_shape(self) -> tuple[int, int, int]:
-        height, width = (64, 128) if self.machine.platform.extended else (32, 64)
-        return (self.config.frames_per_step, height, width)
+        return (self.config.frames_per_step, *screen_values_shape(self.machine.platform))
 
     @property
     def observation_high(self) -> int:
         """The largest observed pixel value: obs_scale, or 3 on XO-CHIP with obs_scale=1."""
-        planes = self.machine.platform.planes
-        return 3 if planes > 1 and self.config.obs_scale == 1 else self.config.obs_scale
+        return screen_values_max(self.machine.platform, self.config.obs_scale)
 
     @property
     def default_params(self) -> EnvParams:

@@ -67,6 +67,7 @@ def _cmd_info(args: argparse.Namespace) -> int:
     from octax_core.env import romstore
     from octax_core.env.environment import EnvConfig
     from octax_core.emulator.platforms import resolve_platform
+    from octax_core.emulator.state import screen_values_max, screen_values_shape
     from octax_core.emulator.quirks import resolve_quirks
     from octax_gym.cli.common import lookup_spec
     from octax_gym.registration import env_id
@@ -82,8 +83,8 @@ def _cmd_info(args: argparse.Namespace) -> int:
     config = EnvConfig(freeze_timers=spec.freeze_timers)  # what gym.make / make_vec use by default
     quirks = resolve_quirks(spec.quirks)
     platform = resolve_platform(spec.platform)
-    screen = "64, 128" if platform.extended else "32, 64"
-    high = 3 if platform.planes > 1 else config.obs_scale  # XO-CHIP: one value per plane combination
+    screen = ", ".join(map(str, screen_values_shape(platform)))
+    high = screen_values_max(platform, config.obs_scale)  # XO-CHIP: one value per plane combination
     status = romstore.rom_status([spec])[0]
     frames, steps_per_second = config.frames_per_step, 60 / config.frames_per_step
     fields = [
