@@ -60,7 +60,9 @@ def test_jax_actions_are_never_read_on_the_step_path(make_envs, monkeypatch):
             assert isinstance(reward, jax.Array)
         envs.step(jnp.array([1, 1, 1]))
     assert not actions.is_ready(), "step() waited for the actions' computation"
-    jax.block_until_ready(envs.state)
+    # The reports themselves, not the state: a report is read once it is ready, and on CI's CPU the
+    # state came out ready while the first report did not yet (the error then came one call later).
+    jax.block_until_ready([report for _, report in envs._action_check._pending])
     with pytest.raises(InvalidActionError, match=r"action 9 is out of range; valid actions are 0\.\.2 \(env 2"):
         envs.step(jnp.array([0, 0, 0]))
     obs, reward, *_ = envs.step(jnp.array([2, 2, 2]))  # after the error, a clean report
