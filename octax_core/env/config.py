@@ -32,7 +32,8 @@ class EnvConfig:
 
     Attributes:
         frames_per_step: 60 Hz frames per env step; the observation holds the screen after each.
-        instructions_per_frame: CHIP-8 instructions per frame.
+        instructions_per_frame: CHIP-8 instructions per frame; `make` takes the game's own
+            (`GameSpec.instructions_per_frame`, an archive game's tickrate) where it names one.
         obs_scale: lit pixels read 1 (default) or 255.
         freeze_timers: zero both timers after each step (the octax package's `disable_delay`);
             `make` takes the game's own setting (`GameSpec.freeze_timers`) unless told.
@@ -81,8 +82,8 @@ def check_option_names(names, valid=ENV_OPTIONS, who: str = "make") -> None:
 def make_config(spec: GameSpec, **options: Any) -> tuple[EnvConfig, EnvParams]:
     """The checked `EnvConfig` and `EnvParams` for `spec` and the given options; boots nothing.
 
-    An option left out, or given as None, takes its default (for `freeze_timers` and
-    `max_episode_steps`, the game's own).
+    An option left out, or given as None, takes its default (for `freeze_timers`,
+    `max_episode_steps` and, where the game names one, `instructions_per_frame`: the game's own).
 
     Raises:
         TypeError: an unknown option (the message lists the valid ones).
@@ -91,6 +92,8 @@ def make_config(spec: GameSpec, **options: Any) -> tuple[EnvConfig, EnvParams]:
     check_option_names(options)
     given = {name: value for name, value in options.items() if value is not None}
     defaults = {"freeze_timers": spec.freeze_timers, "max_episode_steps": spec.max_episode_steps}
+    if spec.instructions_per_frame is not None:
+        defaults["instructions_per_frame"] = spec.instructions_per_frame
     values = {**defaults, **given}
     return _build(EnvConfig, values), _build(EnvParams, values)
 

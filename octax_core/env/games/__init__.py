@@ -1,8 +1,9 @@
 """The game registry: every module in this package exports `SPECS`, a tuple of `GameSpec`.
 
 Modules are discovered, not listed, so adding a game is adding one module. A module may name its
-suite (`SUITE = "ours"`); without one its games are the octax paper's. Lookups raise errors that
-name the valid ids (or suites).
+suite (`SUITE = "ours"`); without one its games are the octax paper's. A subpackage holds a suite
+of its own (`archive/`: the Chip8 Community Archive's games): its `__init__` names the suite, and
+its modules are discovered the same way. Lookups raise errors that name the valid ids (or suites).
 """
 
 from __future__ import annotations
@@ -11,11 +12,13 @@ import importlib
 import pkgutil
 from typing import Optional
 
-from octax_core.env.games.spec import CATEGORIES, GameSpec, key_mask
+from octax_core.env.games.spec import CATEGORIES, GameSpec, bcd_value, key_mask, ram_value, register_value
 
 SUITES = {
     "octax": "the octax paper's suite: 21 classic CHIP-8 titles and their levels",
     "ours": "octax-gym's own games, written in Octo (roms/*.8o): Dodge and Flak, by level",
+    "archive": "games of the Chip8 Community Archive (CC0, shipped in the package): Octojam entries and "
+               "others, CHIP-8, SUPER-CHIP and XO-CHIP",
 }
 _REGISTRY: dict[str, GameSpec] = {}
 _SUITE_OF: dict[str, str] = {}
@@ -35,13 +38,16 @@ def _check_suite(suite: str) -> None:
         raise ValueError(f"unknown suite {suite!r}; valid suites: {', '.join(repr(s) for s in SUITES)}")
 
 
-def _discover() -> None:
-    for module in sorted(pkgutil.iter_modules(__path__), key=lambda m: m.name):
+def _discover(package: str = __name__, path=__path__, suite: str = "octax") -> None:
+    for module in sorted(pkgutil.iter_modules(path), key=lambda m: m.name):
         if module.name == "spec" or module.name.startswith("_"):
             continue
-        games = importlib.import_module(f"{__name__}.{module.name}")
+        games = importlib.import_module(f"{package}.{module.name}")
+        if module.ispkg:
+            _discover(games.__name__, games.__path__, games.SUITE)
+            continue
         for spec in games.SPECS:
-            register(spec, getattr(games, "SUITE", "octax"))
+            register(spec, getattr(games, "SUITE", suite))
 
 
 def list_games(suite: Optional[str] = None) -> list[str]:
@@ -76,4 +82,5 @@ def get_spec(game_id: str) -> GameSpec:
 
 _discover()
 
-__all__ = ["CATEGORIES", "GameSpec", "SUITES", "get_spec", "key_mask", "list_games", "register", "suite_of"]
+__all__ = ["CATEGORIES", "GameSpec", "SUITES", "bcd_value", "get_spec", "key_mask", "list_games", "ram_value", "register",
+           "register_value", "suite_of"]

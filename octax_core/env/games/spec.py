@@ -14,7 +14,7 @@ import jax.numpy as jnp
 
 from octax_core.emulator.platforms import resolve_platform
 from octax_core.emulator.quirks import Quirks
-from octax_core.emulator.state import MachineState
+from octax_core.emulator.state import MEMORY_OFFSET, MachineState
 
 StateFn = Callable[[MachineState], jax.Array]
 
@@ -41,6 +41,8 @@ class GameSpec:
             plane 1, plane 2, both) RGB triples; None uses the renderer's default.
         freeze_timers: zero the delay and sound timers after every env step, as the octax
             package does for most games (its `disable_delay`); off means real 60 Hz timers.
+        instructions_per_frame: the speed the game is written for (the archive's "tickrate");
+            None (the default) takes `EnvConfig`'s, 11, about the COSMAC VIP's pace.
         max_episode_steps: default truncation (env steps of `frames_per_step` frames).
         category: the paper's category (see `CATEGORIES`).
         description: one paragraph: goal, keys, reward, termination.
@@ -62,6 +64,7 @@ class GameSpec:
     quirks: Union[str, Quirks, None] = None
     palette: Optional[tuple[tuple[int, int, int], ...]] = None
     freeze_timers: bool = False
+    instructions_per_frame: Optional[int] = None
     max_episode_steps: int = 5000
     version: int = 0
 
@@ -78,6 +81,8 @@ class GameSpec:
         for mask, frames in self.startup:
             if not (0 <= mask <= 0xFFFF and frames >= 0):
                 raise ValueError(f"{self.id}: startup steps are (key mask 0..0xFFFF, frames >= 0), got {(mask, frames)}")
+        if self.instructions_per_frame is not None and self.instructions_per_frame <= 0:
+            raise ValueError(f"{self.id}: instructions_per_frame must be positive, got {self.instructions_per_frame}")
         if self.max_episode_steps <= 0:
             raise ValueError(f"{self.id}: max_episode_steps must be positive, got {self.max_episode_steps}")
 
@@ -94,6 +99,27 @@ CATEGORIES = (
 def register_value(state: MachineState, index: int) -> jax.Array:
     """V[index] as int32, so that score arithmetic cannot wrap around at 256 as uint8 would."""
     return state.V[index].astype(jnp.int32)
+
+
+def ram_value(state: MachineState, address: int, size: int = 1) -> jax.Array:
+    """The `size` bytes of RAM at `address`, read big-endian as one int32 (a score kept in memory).
+
+    The state stores RAM `MEMORY_OFFSET` bytes in (`octax_core.emulator.state`); this reads it
+    where the program sees it.
+    """
+    value = jnp.int32(0)
+    for offset in range(size):
+        value = value * 256 + state.memory[MEMORY_OFFSET + address + offset].astype(jnp.int32)
+    return value
+
+
+def bcd_value(state: MachineState, address: int, digits: int = 3) -> jax.Array:
+    """The decimal number whose digits (one per byte, most significant first, as FX33 writes
+    them) are at `address`: a score the program keeps, or shows, as BCD."""
+    value = jnp.int32(0)
+    for offset in range(digits):
+        value = value * 10 + state.memory[MEMORY_OFFSET + address + offset].astype(jnp.int32)
+    return value
 
 
 def key_mask(*keys: int) -> int:
