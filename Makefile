@@ -1,6 +1,8 @@
 # make demo   the games table, a random agent's steps/s on Pong, and a video of it (demo-pong.mp4)
-# make test   run the test suite
+# make test   run the test suite (all but the tests marked slow: about 15 minutes on 2 cores)
+# make test-slow  the slow tests: every archive game played, long ROM runs (CI runs both)
 # make bench  throughput of the core on Pong, against the octax package (benchmarks/README.md)
+# make wheel-check  the wheel in a clean venv, offline, empty HOME: every archive game builds
 # make roms   rebuild our own games, roms/*.ch8, from their Octo source roms/*.8o
 #
 # Each target creates .venv when it is missing and installs what it needs into it once: a stamp
@@ -31,7 +33,7 @@ BENCH_ARGS  ?=
 # when they are all there already (a hash check of a few dozen small files).
 ROMS_READY := $(PY) -m octax_gym roms install --if-missing
 
-.PHONY: help demo test bench roms clean
+.PHONY: help demo test test-slow wheel-check bench roms clean
 
 help:
 	@sed -n 's/^# \(make .*\)/\1/p' Makefile
@@ -42,7 +44,14 @@ demo: $(VENV)/.installed-video
 
 test: $(VENV)/.installed-all
 	$(ROMS_READY)
-	$(PY) -m pytest $(PYTEST_ARGS)
+	$(PY) -m pytest $(PYTEST_ARGS) -m "not slow"
+
+test-slow: $(VENV)/.installed-all
+	$(ROMS_READY)
+	$(PY) -m pytest $(PYTEST_ARGS) -m slow
+
+wheel-check:
+	bash .ci/wheel-check
 
 bench: $(VENV)/.installed-dev
 	$(ROMS_READY)

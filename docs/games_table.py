@@ -1,5 +1,8 @@
 """Prints the games table of docs/games.md from the registry: `python docs/games_table.py`.
 
+The octax paper's suite and our own games; the archive suite has its own page, docs/gallery.md
+(`python docs/gallery.py`), with previews and measured play.
+
 tests/core_games/test_all_games.py checks that docs/games.md holds exactly this output.
 """
 
@@ -11,7 +14,7 @@ HEADER = ("| id | category | actions (keys) | quirks | timers | max steps | ROM 
 
 def games_table() -> str:
     rows = [HEADER]
-    for game_id in octax_core.list_games():
+    for game_id in sorted(octax_core.list_games("octax") + octax_core.list_games("ours")):
         spec = octax_core.get_spec(game_id)
         keys = ", ".join(f"{k:X}" for k in spec.action_keys)
         timers = "frozen" if spec.freeze_timers else "60 Hz"

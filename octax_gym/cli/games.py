@@ -65,7 +65,7 @@ def _cmd_list(args: argparse.Namespace) -> int:
 
 def _cmd_info(args: argparse.Namespace) -> int:
     from octax_core.env import romstore
-    from octax_core.env.environment import EnvConfig
+    from octax_core.env.config import make_config
     from octax_core.emulator.platforms import resolve_platform
     from octax_core.emulator.state import screen_values_max, screen_values_shape
     from octax_core.emulator.quirks import resolve_quirks
@@ -80,7 +80,7 @@ def _cmd_info(args: argparse.Namespace) -> int:
         print(f"octax-gym info: error: unknown game {args.game!r}; valid ids: {', '.join(games) or 'none'}"
               + (f" (or their Gymnasium ids, e.g. {env_id(games[0])})" if games else ""), file=sys.stderr)
         return 1
-    config = EnvConfig(freeze_timers=spec.freeze_timers)  # what gym.make / make_vec use by default
+    config = make_config(spec)[0]  # what gym.make / make_vec use by default (the game's own speed and timers)
     quirks = resolve_quirks(spec.quirks)
     platform = resolve_platform(spec.platform)
     screen = ", ".join(map(str, screen_values_shape(platform)))

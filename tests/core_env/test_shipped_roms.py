@@ -6,10 +6,13 @@ from __future__ import annotations
 
 import hashlib
 import json
+import os
 import subprocess
 import sys
 import zipfile
 from pathlib import Path
+
+import pytest
 
 from octax_core.env.romstore import ARCHIVE_ROM_DIR, PROJECT_ROM_DIR
 
@@ -39,15 +42,49 @@ def test_the_licence_note_says_cc0_and_credits_every_program():
         assert all(author in row for author in entry["authors"]) and entry["platform"] in row
 
 
-def test_a_wheel_ships_our_roms_and_the_archive(tmp_path):
-    """Built from this checkout (setuptools, no network); the fix for wheels that lacked Dodge and Flak."""
+@pytest.fixture(scope="module")
+def wheel(tmp_path_factory) -> Path:
+    """A wheel built from this checkout (setuptools, no network)."""
+    folder = tmp_path_factory.mktemp("dist")
     result = subprocess.run([sys.executable, "-m", "pip", "wheel", str(REPO), "--no-deps", "--no-build-isolation",
-                             "-q", "-w", str(tmp_path)], capture_output=True, text=True, timeout=300, check=False)
+                             "-q", "-w", str(folder)], capture_output=True, text=True, timeout=300, check=False)
     assert result.returncode == 0, result.stderr
-    (wheel,) = tmp_path.glob("octax_gym-*.whl")
+    (built,) = folder.glob("octax_gym-*.whl")
+    return built
+
+
+def test_a_wheel_ships_our_roms_and_the_archive(wheel):
+    """The fix for wheels that lacked Dodge and Flak."""
     with zipfile.ZipFile(wheel) as archive:
         names = set(archive.namelist())
         for name in ("dodge.ch8", "flak.ch8"):
             assert archive.read(f"octax_core/env/roms/{name}") == (PROJECT_ROM_DIR / name).read_bytes()
         shipped = {Path(n).name for n in names if n.startswith("octax_core/env/roms/archive/")}
     assert shipped == {p.name for p in ARCHIVE_ROM_DIR.iterdir()}
+
+
+def test_archive_games_play_from_the_wheel_alone(wheel, tmp_path):
+    """The wheel's own files, not this checkout's, with an empty HOME and no OCTAX_ROM_DIR: archive
+    games build from the ROMs inside it. (`python -S` skips site-packages' .pth files, so the
+    checkout's editable install is not imported; the dependencies come from the venv's folder.
+    `make wheel-check` does the whole thing: a clean venv, offline, every archive game.)"""
+    unpacked = tmp_path / "unpacked"
+    with zipfile.ZipFile(wheel) as archive:
+        archive.extractall(unpacked)
+    home = tmp_path / "home"
+    home.mkdir()
+    site_packages = next(p for p in sys.path if p.endswith("site-packages"))
+    script = ("import gymnasium, octax_core, octax_gym\n"
+              "print(octax_core.__file__)\n"
+              "for game in ('SuperPong', 'DodgeArchive'):\n"
+              "    env = gymnasium.make(octax_gym.env_id(game))\n"
+              "    obs, _ = env.reset(seed=0)\n"
+              "    print(game, obs.shape, env.step(1)[4]['score'])\n")
+    env = {"HOME": str(home), "PATH": "/usr/bin:/bin", "PYTHONPATH": f"{unpacked}{os.pathsep}{site_packages}"}
+    result = subprocess.run([sys.executable, "-S", "-c", script], cwd=tmp_path, env=env, capture_output=True,
+                            text=True, timeout=300, check=False)
+    assert result.returncode == 0, result.stderr
+    lines = result.stdout.splitlines()
+    assert lines[0] == str(unpacked / "octax_core" / "__init__.py")
+    assert lines[1].startswith("SuperPong (4, 32, 64)") and lines[2].startswith("DodgeArchive (4, 64, 128)")
+    assert not any(home.iterdir())

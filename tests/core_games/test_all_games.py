@@ -1,6 +1,6 @@
-"""Every registered game: the registry holds the issue's ids and our own games', each passes the
-env contract suite, and each level family member survives random play (the per-group files and
-test_own_games.py cover the rest)."""
+"""Every game of the octax and ours suites: the registry holds the paper's ids and our own games',
+each passes the env contract suite, and each level family member survives random play (the
+per-group files and test_own_games.py cover the rest). The archive suite: test_archive_suite.py."""
 
 import jax
 import numpy as np
@@ -25,8 +25,10 @@ OTHER_LEVELS = [g for g in EXPECTED_IDS if g.startswith(("Cavern", "SpaceFlight"
                 and g not in ("Cavern1", "SpaceFlight1", "TargetShooter1")]
 
 
-def test_registry_holds_exactly_the_suite():
-    assert octax_core.list_games() == EXPECTED_IDS
+def test_registry_holds_exactly_the_suites():
+    archive = octax_core.list_games(suite="archive")
+    assert octax_core.list_games() == sorted(EXPECTED_IDS + archive)
+    assert not set(archive) & set(EXPECTED_IDS)
 
 
 def test_suites_split_the_registry():
@@ -34,9 +36,10 @@ def test_suites_split_the_registry():
 
     assert octax_core.list_games(suite="octax") == sorted(PAPER_IDS)
     assert octax_core.list_games(suite="ours") == OWN_IDS
-    assert sorted(octax_core.list_games(suite) for suite in SUITES) == sorted([sorted(PAPER_IDS), OWN_IDS])
-    assert suite_of("Pong") == "octax" and suite_of("Flak2") == "ours"
-    with pytest.raises(ValueError, match="unknown suite 'atari'; valid suites: 'octax', 'ours'"):
+    assert list(SUITES) == ["octax", "ours", "archive"]
+    assert sorted(g for suite in SUITES for g in octax_core.list_games(suite)) == octax_core.list_games()
+    assert suite_of("Pong") == "octax" and suite_of("Flak2") == "ours" and suite_of("SuperPong") == "archive"
+    with pytest.raises(ValueError, match="unknown suite 'atari'; valid suites: 'octax', 'ours', 'archive'"):
         octax_core.list_games(suite="atari")
     with pytest.raises(KeyError, match="unknown game 'Pacman'"):
         suite_of("Pacman")

@@ -167,3 +167,13 @@ def test_list_runs_as_a_command():
                             capture_output=True, text=True, timeout=120, check=False)
     assert result.returncode == 0, result.stderr
     assert "octax/Airplane-v0" in result.stdout and "octax/Pong-v0" not in result.stdout
+
+
+def test_info_and_list_show_an_archive_game_s_own_speed(capsys):
+    assert cli.main(["info", "SuperPong"]) == 0
+    out = capsys.readouterr().out
+    assert "step:              4 frames x 30 instructions (15 steps per second of game time)" in out  # its tickrate
+    assert "rom:               archive/superpong.ch8" in out and "verified" in out
+    assert cli.main(["list", "--suite", "archive"]) == 0
+    rows = [line.split()[0] for line in capsys.readouterr().out.splitlines()[1:] if line.startswith("octax/")]
+    assert rows == [env_id(game) for game in list_games(suite="archive")]

@@ -10,7 +10,7 @@ move together left and right, the ball, and the score (2 digits) in the middle.
 4: key 9 (right); 2 pixels per ball move. (Key 6, which restarts the game, is not offered.)
 
 ### Reward
-Change of the score the ROM shows: +1 per paddle hit. The ROM keeps it in VD (`:alias score vd`)
++1 per paddle hit: the change of the score the ROM shows. The ROM keeps it in VD (`:alias score vd`)
 but its game-over routine reuses VD as a drawing coordinate, so the score is read from the three
 BCD digits `draw-score` writes at `bcd-digits` (0x21A), which hold the last score shown.
 
