@@ -114,3 +114,14 @@ def test_contract_on_one_game_per_platform(platform):
     game_id = min((g for g in ARCHIVE if octax_core.get_spec(g).platform == platform),
                   key=lambda g: (octax_core.get_spec(g).instructions_per_frame, g))
     check_env(game_id, num_envs=2, steps=3)
+
+
+def test_every_programs_colours_parse():
+    from octax_core.env.games.archive._program import _rgb, programs
+
+    assert _rgb("#FFAA00") == (255, 170, 0) and _rgb("#fa0") == (255, 170, 0) and _rgb("lightcyan") == (224, 255, 255)
+    for name, entry in programs().items():
+        palette = archive_palette(name)
+        assert palette is None or len(palette) == (4 if entry["platform"] == "xochip" else 2), name
+    with pytest.raises(ValueError, match="colour 'mauve': not '#RRGGBB', '#RGB' or one of aquamarine"):
+        _rgb("mauve")

@@ -35,9 +35,27 @@ def program(name: str) -> dict[str, Any]:
         raise KeyError(f"no program {name!r} in the archive; valid: {', '.join(sorted(programs()))}") from None
 
 
+# The CSS colour names programs.json uses besides '#RRGGBB' (values from the CSS Color Module).
+CSS_COLOURS = {
+    "black": "#000000", "white": "#FFFFFF", "gray": "#808080", "lightgray": "#D3D3D3", "red": "#FF0000",
+    "navy": "#000080", "lightcyan": "#E0FFFF", "lavender": "#E6E6FA", "aquamarine": "#7FFFD4",
+    "hotpink": "#FF69B4", "deeppink": "#FF1493", "powderblue": "#B0E0E6",
+}
+
+
 def _rgb(colour: str) -> tuple[int, int, int]:
-    """'#RRGGBB' -> (r, g, b)."""
-    value = int(colour.lstrip("#"), 16)
+    """'#RRGGBB', '#RGB' or a CSS colour name -> (r, g, b).
+
+    Raises:
+        ValueError: a colour neither form names.
+    """
+    code = CSS_COLOURS.get(colour.lower(), colour)
+    digits = code.lstrip("#")
+    if len(digits) == 3:
+        digits = "".join(d * 2 for d in digits)
+    if not code.startswith("#") or len(digits) != 6:
+        raise ValueError(f"colour {colour!r}: not '#RRGGBB', '#RGB' or one of {', '.join(sorted(CSS_COLOURS))}")
+    value = int(digits, 16)
     return (value >> 16) & 0xFF, (value >> 8) & 0xFF, value & 0xFF
 
 
