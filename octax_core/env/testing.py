@@ -62,7 +62,9 @@ def _check_outputs(env: Env, params: EnvParams, reset, step, keys) -> None:
     obs, state = reset(keys, params)
     assert obs.shape == (n, *env.observation_shape), f"{name}: reset obs shape {obs.shape[1:]} != {env.observation_shape}"
     assert obs.dtype == jnp.uint8, f"{name}: obs dtype {obs.dtype} != uint8"
-    assert set(np.unique(np.asarray(obs))) <= {0, env.config.obs_scale}, f"{name}: obs pixels not 0/{env.config.obs_scale}"
+    high = env.observation_high  # XO-CHIP: a code per plane combination, 0..3 (or 0, 85, 170, 255)
+    valid = set(range(0, high + 1, high // 3)) if env.machine.platform.planes > 1 else {0, high}
+    assert set(np.unique(np.asarray(obs))) <= valid, f"{name}: obs pixels {set(np.unique(np.asarray(obs)))} not in {valid}"
     obs, state, reward, terminated, truncated, info = step(keys, state, jnp.zeros(n, jnp.int32), params)
     assert obs.shape == (n, *env.observation_shape) and obs.dtype == jnp.uint8, f"{name}: step obs {obs.shape} {obs.dtype}"
     assert reward.shape == (n,) and reward.dtype == jnp.float32, f"{name}: reward {reward.shape} {reward.dtype}"

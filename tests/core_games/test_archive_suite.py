@@ -125,3 +125,9 @@ def test_every_programs_colours_parse():
         assert palette is None or len(palette) == (4 if entry["platform"] == "xochip" else 2), name
     with pytest.raises(ValueError, match="colour 'mauve': not '#RRGGBB', '#RGB' or one of aquamarine"):
         _rgb("mauve")
+
+
+@pytest.mark.parametrize("obs_scale", [1, 255])
+def test_contract_takes_xochip_plane_codes(obs_scale):
+    """Civiliz8n's title lights both planes: codes 0..3 (x 85 at obs_scale 255), which the contract allows."""
+    check_env("Civiliz8n", num_envs=2, steps=2, obs_scale=obs_scale)
