@@ -12,7 +12,8 @@ import importlib
 import pkgutil
 from typing import Optional
 
-from octax_core.env.games.spec import CATEGORIES, GameSpec, bcd_value, key_mask, ram_value, register_value
+from octax_core.env.games.spec import (CATEGORIES, GameSpec, bcd_value, in_routine, key_mask, ram_value,
+                                       register_value)
 
 SUITES = {
     "octax": "the octax paper's suite: 21 classic CHIP-8 titles and their levels",
@@ -82,5 +83,5 @@ def get_spec(game_id: str) -> GameSpec:
 
 _discover()
 
-__all__ = ["CATEGORIES", "GameSpec", "SUITES", "bcd_value", "get_spec", "key_mask", "list_games", "ram_value", "register",
+__all__ = ["CATEGORIES", "GameSpec", "SUITES", "bcd_value", "get_spec", "in_routine", "key_mask", "list_games", "ram_value", "register",
            "register_value", "suite_of"]

@@ -122,6 +122,18 @@ def bcd_value(state: MachineState, address: int, digits: int = 3) -> jax.Array:
     return value
 
 
+def in_routine(state: MachineState, start: int, end: int) -> jax.Array:
+    """True while the program runs the code at start..end-1 or a subroutine it called from there:
+    pc is in the range, or a return address on the stack is (a game-over routine that calls its
+    drawing helpers is still the game over while they run)."""
+    def inside(address):
+        return (address >= start) & (address < end)
+
+    depth = jnp.arange(state.stack.shape[0])
+    called_from = inside(state.stack - 2) & (depth < state.sp.astype(depth.dtype))
+    return inside(state.pc) | called_from.any()
+
+
 def key_mask(*keys: int) -> int:
     """The 16-bit mask holding `keys`, for `GameSpec.startup`."""
     mask = 0
