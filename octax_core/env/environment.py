@@ -59,7 +59,8 @@ class Env:
     one value per plane combination (`octax_core.emulator.state.screen_values`: 0..3, or 0, 85,
     170, 255; `observation_high` is the largest). Action: int in 0..num_actions-1; 0 holds no key and
     action i holds `spec.action_keys[i - 1]` for the whole step. Reward: change of the game's
-    score over the step, float32. Termination: the spec's `terminated_fn`; truncation after
+    score over the step, float32, plus `spec.survival_reward` for a step the game goes on after
+    (a game with no score of its own). Termination: the spec's `terminated_fn`; truncation after
     `params.max_episode_steps` steps. `info`: score, lives (-1 where the game keeps none),
     episode_step, and with autoreset the final observation and info of an episode that just ended.
     """
@@ -126,6 +127,8 @@ class Env:
         episode_step = jnp.where(state.done, state.episode_step, state.episode_step + 1)
         truncated = ~terminated & (episode_step >= params.max_episode_steps)
         reward = jnp.where(state.done, 0.0, score - state.score).astype(jnp.float32)
+        if self.spec.survival_reward:  # a game with no score of its own: a reward per step survived
+            reward = reward + jnp.where(state.done | terminated, 0.0, self.spec.survival_reward).astype(jnp.float32)
         new_state = EnvState(machine=machine, score=score, episode_step=episode_step,
                              last_action=jnp.where(state.done, state.last_action, action),
                              done=terminated | truncated)

@@ -131,3 +131,24 @@ def test_every_programs_colours_parse():
 def test_contract_takes_xochip_plane_codes(obs_scale):
     """Civiliz8n's title lights both planes: codes 0..3 (x 85 at obs_scale 255), which the contract allows."""
     check_env("Civiliz8n", num_envs=2, steps=2, obs_scale=obs_scale)
+
+
+def test_survival_reward_pays_each_step_the_game_goes_on():
+    """Flight Runner (the archive's) keeps no score: +1 a step while it flies, nothing once ended."""
+    import jax
+
+    env, params = octax_core.make("FlightRunnerArchive")
+    _, state = env.reset(jax.random.key(0), params)
+    step = jax.jit(env.step)
+    rewards, ended = [], False
+    for t in range(400):
+        _, state, reward, terminated, truncated, info = step(jax.random.key(t), state, 0, params)
+        rewards.append(float(reward))
+        assert float(info["score"]) == 0.0
+        if bool(terminated):
+            ended = True
+            break
+    assert ended and rewards[-1] == 0.0 and set(rewards[:-1]) == {1.0}
+    _, _, reward, *_ = step(jax.random.key(999), state, 0, params)
+    assert float(reward) == 0.0  # an ended episode stands still
+    assert octax_core.get_spec("Pong").survival_reward == 0.0

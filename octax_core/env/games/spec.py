@@ -41,6 +41,9 @@ class GameSpec:
             plane 1, plane 2, both) RGB triples; None uses the renderer's default.
         freeze_timers: zero the delay and sound timers after every env step, as the octax
             package does for most games (its `disable_delay`); off means real 60 Hz timers.
+        survival_reward: added to the reward of every step after which the game is still on (not
+            the step that ends it), for a game that keeps no score: survival is then its return.
+            0 (the default) adds nothing, and the step's traced program is unchanged.
         instructions_per_frame: the speed the game is written for (the archive's "tickrate");
             None (the default) takes `EnvConfig`'s, 11, about the COSMAC VIP's pace.
         max_episode_steps: default truncation (env steps of `frames_per_step` frames).
@@ -65,6 +68,7 @@ class GameSpec:
     palette: Optional[tuple[tuple[int, int, int], ...]] = None
     freeze_timers: bool = False
     instructions_per_frame: Optional[int] = None
+    survival_reward: float = 0.0
     max_episode_steps: int = 5000
     version: int = 0
 
