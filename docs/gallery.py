@@ -6,7 +6,7 @@ its platform, speed, keys, authors, what the reward counts (the first sentence o
 "### Reward" section), and what random play measured at N=64 envs on this machine: the mean
 return and length of the episodes that ended, and env steps per second.
 
-Measuring plays every game for a fixed budget of emulated instructions (about 20 s of this
+Measuring plays every game for a fixed budget of emulated instructions (about 10 s of this
 machine's time per game), so a game at 1,000 instructions per frame plays far fewer steps than
 one at 15; where no episode ended within its steps the page says so. Results are kept in
 docs/gallery/measurements.json: a run measures only the games missing there (or those named with
@@ -32,10 +32,10 @@ PAGE = DOCS / "gallery.md"
 ARCHIVE_COMMIT = "0a41cc23ad5c"
 SOURCE_URL = "https://github.com/JohnEarnest/chip8Archive/tree/{commit}/src/{name}"
 NUM_ENVS = 64
-# Emulated instructions per game for the measurement, and the steps' bounds: about 20 s here for a
+# Emulated instructions per game for the measurement, and the steps' bounds: about 10 s here for a
 # CHIP-8 game (its instructions are ~10x cheaper than SUPER-CHIP's and XO-CHIP's, see
-# benchmarks/platforms.py), about 20-60 s for the others.
-INSTRUCTION_BUDGET = {"chip8": 2.0e8, "schip": 2.5e7, "xochip": 1.2e7}
+# benchmarks/platforms.py), about 10-30 s for the others.
+INSTRUCTION_BUDGET = {"chip8": 1.0e8, "schip": 1.2e7, "xochip": 6.0e6}
 MIN_STEPS, MAX_STEPS = 50, 3000
 PREVIEW_FRAMES = 4
 SLOW_TICKRATE = 200  # games at this many instructions per frame or more are listed as slow
