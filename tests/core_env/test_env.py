@@ -40,6 +40,12 @@ def test_contract_suite_passes(rom_path):
     check_env(COUNTER, rom=rom_path, obs_scale=255, autoreset=True, frames_per_step=2)
 
 
+def test_the_contract_suite_has_its_public_address():
+    import octax_core.testing
+
+    assert octax_core.testing.check_env is check_env is octax_core.check_env
+
+
 def test_contract_suite_catches_a_broken_game(rom_path):
     import dataclasses
     broken = dataclasses.replace(COUNTER, score_fn=lambda s: s.V[0] / 0.0)  # inf / nan rewards
