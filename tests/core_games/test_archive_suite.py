@@ -108,6 +108,19 @@ def test_the_docs_gallery_lists_every_archive_game():
     assert gallery["registry_rows"]() == gallery["page_rows"](page), "docs/gallery.md is stale: run python docs/gallery.py"
 
 
+def test_every_archive_program_is_a_game_or_left_out_with_a_reason():
+    import runpy
+    from pathlib import Path
+
+    from octax_core.env.games.archive._program import programs
+
+    gallery = runpy.run_path(str(Path(__file__).resolve().parents[2] / "docs" / "gallery.py"))
+    registered = [gallery["program_name"](octax_core.get_spec(g)) for g in ARCHIVE]
+    left_out = [name for names, why in gallery["LEFT_OUT"] for name in names]
+    assert all(why for names, why in gallery["LEFT_OUT"])
+    assert sorted(list(set(registered)) + left_out) == sorted(programs()), "a program is neither a game nor left out (or both)"
+
+
 @pytest.mark.parametrize("platform", ["chip8", "schip", "xochip"])
 def test_contract_on_one_game_per_platform(platform):
     """The cheapest game of each platform (fewest instructions per frame); every game: tests/archive_games."""
