@@ -59,7 +59,8 @@ def test_every_game_takes_its_programs_json_options():
         assert spec.platform == entry["platform"], game_id
         assert spec.quirks == quirks_from_octo(entry["options"]), game_id
         assert spec.instructions_per_frame == int(entry["options"]["tickrate"]), game_id
-        assert spec.palette == archive_palette(program_of(game_id)) and spec.palette is not None, game_id
+        assert spec.palette == archive_palette(program_of(game_id)), game_id  # None: the program names no colours
+        assert (spec.palette is None) == ("fillColor" not in entry["options"]), game_id
 
 
 def test_make_takes_the_games_speed_unless_told():

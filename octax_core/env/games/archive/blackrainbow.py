@@ -13,7 +13,7 @@ keys are read every loop (1 frame), several at once in the ROM but one per actio
 Octo's X, which pauses and shows the time, is not offered.)
 
 ### Reward
-Minus the change of the time the ROM keeps and shows at the end, `timer-data` (0xA2F, units, and
+-1 per time unit on the ROM's clock and +2 per gem taken. It is minus the change of the time the ROM keeps and shows at the end, `timer-data` (0xA2F, units, and
 0xA30, hundreds): it counts up once every 64 loops (`global-timer`, `tick` v7 up to `tick-max`),
 and each gem taken (`take-gem`) sets it back by `gem-time`, 2, never below 0. So -1 per time unit
 and +2 per gem (less at a time under 2); the return is minus the final time, the game's own score

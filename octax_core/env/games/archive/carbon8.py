@@ -13,7 +13,8 @@ in, power cools the target, filler adds mass without cooling; the slab grows by 
 per loop (`fill_remaining` v6 overflows into `fill_target` v7, done past 0x0F).
 
 ### Reward
-The ROM keeps no score, only Jabba's verdict at the end of a level: the external (`temp_ex` vC) and
++1 for each of the two temperatures inside its goal range as the slab completes (0 to 2). The ROM
+keeps no score, only Jabba's verdict at the end of a level: the external (`temp_ex` vC) and
 internal (`temp_in` vD) temperatures are each compared with the level's goal range (`goals` at
 0xAC9, 8 bytes a level: external min/max in bytes 0-1, internal min/max in bytes 4-5) at the
 instant the slab completes. The reward is that verdict: +1 for each temperature inside its range

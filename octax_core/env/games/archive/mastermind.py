@@ -16,8 +16,8 @@ counts once at most and may not count at all. (Key C, Octo's 4, which shows the 
 is not offered; a key other than 8 on the title also pages through them, as the ROM does.)
 
 ### Reward
-On a win, 12 minus the number of guesses (11 for the first guess, 1 for the eleventh; the ROM
-shows the count next to its happy face); nothing for a loss. It is read from the clues the ROM
+On a win, 12 minus the guesses used; nothing for a loss. That is 11 for the first guess, 1 for the
+eleventh (the ROM shows the count next to its happy face). It is read from the clues the ROM
 keeps, `black_clues` (0x232, one byte per column, which `check_4_win` writes as each guess is
 scored): the first column with 4 black marks, c (0-based), scores 11 - c; the registers
 (`black_count` v8, `play_column` vd) are reused or rewritten by the end-of-game drawing. A guess

@@ -13,7 +13,7 @@ which one held key cannot do, so the agent shoots straight: over the cactus from
 (`lefty` 1..3) or beside it, when the outlaw walks there.
 
 ### Reward
-The ROM keeps no score, and an episode is one duel: +1 when the player shoots the outlaw, -1 when
++1 for shooting the outlaw, -1 for being shot: the ROM keeps no score, and an episode is one duel: +1 when the player shoots the outlaw, -1 when
 the outlaw shoots the player, 0 on every other step. The outcome is read once the ROM sits in
 `gameover` (0x39E..0x3AB, the 32-frame pause after a hit): `rightdead` (0x398) has erased the
 outlaw's sprite, `leftdead` (0x3AC) the player's, so the outcome is whether the outlaw's 8x12 box at

@@ -14,7 +14,8 @@ after a key is pressed and released on the between-turns screen (FX0A in `new_tu
 that holds one key forever waits there until the episode is cut.
 
 ### Reward
-The change of `score` (V9, `:alias score v9`): +1 per turn started, +3 per obstacle passed, +1
++1 per turn started, +3 per obstacle passed and bonuses over time, the ROM's own score. It is the change
+of `score` (V9, `:alias score v9`): +1 per turn started, +3 per obstacle passed, +1
 every 50 game ticks and +6 every 100 (when the game speeds up).
 
 ### Termination

@@ -13,7 +13,8 @@ complete guess; on the title, start the round), 2: key 7 (cursor left, A), 3: ke
 key is released (`debounce`), so a repeated action is one press.
 
 ### Reward
-The game keeps no score, so the reward follows its feedback: +1 for each letter first placed in
++1 per letter first placed in its right spot, +5 per word solved. The game keeps no score, so the
+reward follows its feedback: +1 for each letter first placed in
 its right spot (the ROM sets its byte in `found`, 0xBDB, 26 bytes, cleared by `init`), and +5
 for solving the word (while `game-win`, 0x548, runs). A solved word has earned 1 to 3 green
 letters, so a round returns 6 to 8 when won, at most 3 when lost. Guesses that are not in the
