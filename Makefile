@@ -2,7 +2,7 @@
 # make test   run the test suite (all but the tests marked slow: about 15 minutes on 2 cores)
 # make test-slow  the slow tests: every archive game played, long ROM runs (CI runs both)
 # make bench  throughput of the core on Pong, against the octax package (benchmarks/README.md)
-# make wheel-check  the wheel in a clean venv, offline, empty HOME: every archive game builds
+# make wheel-check  the wheel in a clean venv, offline, empty HOME: every archive game builds and passes check_env
 # make roms   rebuild our own games, roms/*.ch8, from their Octo source roms/*.8o
 #
 # Each target creates .venv when it is missing and installs what it needs into it once: a stamp
