@@ -131,7 +131,8 @@ def execute(quirks: Quirks, state: MachineState, keys: jax.Array, stalled=None):
         stalled: bool; when true the frame is over (display wait) and nothing changes.
 
     Returns:
-        (new state, whether a DXYN ran).
+        (new state, the int32 `Kind` that ran: STALL while stalled; `idle` reads it to know
+        whether the instruction wrote memory or the screen).
     """
     fetched = fetch(quirks, state, keys, stalled)
     kind, c = fetched.kind, fetched.context
@@ -144,7 +145,7 @@ def execute(quirks: Quirks, state: MachineState, keys: jax.Array, stalled=None):
     sprite = _sprite_mask(quirks, memory, c, jnp.where(kind == Kind.DRW, fetched.fields.n, 0))
     effects[Kind.DRW] = display.op_dxyn(c._replace(collision=display.collides(state.screen, sprite)))
     new_state = _apply(state, kind, effects, merge(kind, effects, defaults), memory, sprite, c)
-    return new_state, kind == Kind.DRW
+    return new_state, kind
 
 
 def _write_memory(memory, effect: Effect, c: Context):
@@ -216,9 +217,9 @@ def run_frame(quirks: Quirks, instructions_per_frame: int, state: MachineState, 
 
     def instruction(carry, _):
         state, frame_over = carry
-        state, drew = execute(quirks, state, keys, frame_over if gated else None)
+        state, kind = execute(quirks, state, keys, frame_over if gated else None)
         if quirks.display_wait:  # the VIP's DXYN waits for the next vertical blank
-            frame_over = frame_over | drew
+            frame_over = frame_over | (kind == Kind.DRW)
         return (state, frame_over), None
 
     # Built from the state so that it is batched / sharded like the state (shard_map, vmap).

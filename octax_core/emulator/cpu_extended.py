@@ -84,7 +84,7 @@ def _defaults(state: MachineState, c: Context) -> Effect:
 
 
 def execute(platform: Platform, quirks: Quirks, state: MachineState, keys, stalled):
-    """Runs the instruction at pc (see `cpu.execute`); returns (new state, whether a DXYN ran)."""
+    """Runs the instruction at pc (see `cpu.execute`); returns (new state, the `Kind` that ran)."""
     fetched = fetch(platform, quirks, state, keys, stalled)
     kind, c = fetched.kind, fetched.context
     table = handlers(platform)
@@ -98,7 +98,7 @@ def execute(platform: Platform, quirks: Quirks, state: MachineState, keys, stall
                               platform.planes, quirks.clipping, drawing)
     effects[Kind.DRW] = extended.op_dxyn(c._replace(collision=planes.collides(state.screen, mask)))
     effect = cpu.merge(kind, effects, defaults)
-    return _apply(platform, state, kind, effects, effect, memory, mask, c), drawing
+    return _apply(platform, state, kind, effects, effect, memory, mask, c), kind
 
 
 def _sprite_bytes(platform: Platform, memory, c: Context):
@@ -177,9 +177,9 @@ def run_frame(platform: Platform, quirks: Quirks, instructions_per_frame: int, s
 
     def instruction(carry, _):
         state, frame_over = carry
-        state, drew = execute(platform, quirks, state, keys, frame_over)
+        state, kind = execute(platform, quirks, state, keys, frame_over)
         if quirks.display_wait:
-            frame_over = frame_over | drew
+            frame_over = frame_over | (kind == Kind.DRW)
         return (state, frame_over | state.exited), None
 
     still = state.exited if halted is None else state.exited | halted

@@ -15,13 +15,13 @@ from typing import Union
 import jax
 import jax.numpy as jnp
 
-from octax_core.emulator import cpu, cpu_extended
+from octax_core.emulator import cpu, cpu_extended, idle
 from octax_core.emulator.keypad import keys_to_mask
 from octax_core.emulator.platforms import Platform, check_program_fits, resolve_platform
 from octax_core.emulator.quirks import Quirks, resolve_quirks
 from octax_core.emulator.rom import Rom, RomLike
 from octax_core.emulator.state import MachineState, boot_state
-from octax_core.validate import check_int
+from octax_core.validate import check_bool, check_int
 
 
 @dataclasses.dataclass(frozen=True)
@@ -36,6 +36,12 @@ class Machine:
             None (the default) takes the platform's own profile, the one of the same name.
         instructions_per_frame: instructions run per 60 Hz frame (11 is about the COSMAC VIP's
             speed on typical game code).
+        skip_idle: fast-forward the rest of a frame once the program provably spins (an exact
+            cycle of its registers with no memory or screen write: timer waits, key polls, FX0A),
+            and give each machine of a batch its own frame clock (`octax_core.emulator.idle`).
+            Bit-identical to running every instruction; False runs every one, in lockstep. It
+            takes effect from `idle.SKIP_FROM` (25) instructions per frame: a shorter frame has
+            too little to skip for the clock's bookkeeping to pay, and runs plain.
 
     Example:
         >>> import jax, octax_core
@@ -49,6 +55,7 @@ class Machine:
     platform: Union[Platform, str] = "chip8"
     quirks: Union[Quirks, str, None] = None
     instructions_per_frame: int = 11
+    skip_idle: bool = True
 
     def __post_init__(self):
         platform = resolve_platform(self.platform)
@@ -56,6 +63,7 @@ class Machine:
         object.__setattr__(self, "quirks", resolve_quirks(platform.default_quirks if self.quirks is None else self.quirks))
         object.__setattr__(self, "instructions_per_frame",
                            check_int("instructions_per_frame", self.instructions_per_frame))
+        object.__setattr__(self, "skip_idle", check_bool("skip_idle", self.skip_idle))
 
     def boot(self, rom: RomLike, key: jax.Array) -> MachineState:
         """A powered-on machine with `rom` loaded at 0x200; the key seeds CXNN.
@@ -102,6 +110,8 @@ class Machine:
             ValueError: a negative frame count given as an int.
         """
         mask = keys_to_mask(keys)
+        if self.skip_idle and self.instructions_per_frame >= idle.SKIP_FROM:
+            return self._run_frames_skipping(state, mask, frames, halted, record_screens)
 
         def frame(state):
             if self.platform.extended:
@@ -110,18 +120,9 @@ class Machine:
             return cpu.run_frame(self.quirks, self.instructions_per_frame, state, mask, halted)
 
         if isinstance(frames, jax.Array) and not record_screens:
-            if frames.shape != () or not jnp.issubdtype(frames.dtype, jnp.integer):
-                raise TypeError(f"frames must be an int or an integer scalar array, got {frames.dtype} {frames.shape}")
+            _check_traced_frames(frames)
             return jax.lax.fori_loop(0, frames, lambda _, state: frame(state), state)
-        try:
-            frames = operator.index(frames)
-        except TypeError:
-            raise TypeError(
-                f"frames must be a Python int (mark it static under jit){'' if record_screens else ' or an integer scalar array'}, "
-                f"got {type(frames).__name__}"
-            ) from None
-        if frames < 0:
-            raise ValueError(f"frames must be >= 0, got {frames}")
+        frames = _check_static_frames(frames, record_screens)
 
         def body(state, _):
             state = frame(state)
@@ -129,3 +130,36 @@ class Machine:
 
         state, screens = jax.lax.scan(body, state, None, length=frames)
         return (state, screens) if record_screens else state
+
+    def _run_frames_skipping(self, state: MachineState, mask, frames, halted, record_screens: bool):
+        """`run_frames` with idle instructions skipped (`octax_core.emulator.idle`)."""
+        still = jnp.zeros_like(state.pc, dtype=jnp.bool_) if halted is None else jnp.asarray(halted, jnp.bool_)
+        if state.exited is not None:
+            still = still | state.exited
+        if isinstance(frames, jax.Array) and not record_screens:
+            _check_traced_frames(frames)
+            one = idle.frame_runner(self.platform, self.quirks, self.instructions_per_frame, 1, False)
+            still_now = lambda state: still if state.exited is None else still | state.exited
+            return jax.lax.fori_loop(0, frames, lambda _, state: one(state, mask, still_now(state))[0], state)
+        frames = _check_static_frames(frames, record_screens)
+        run = idle.frame_runner(self.platform, self.quirks, self.instructions_per_frame, frames, record_screens)
+        state, screens = run(state, mask, still)
+        return (state, screens) if record_screens else state
+
+
+def _check_traced_frames(frames: jax.Array) -> None:
+    if frames.shape != () or not jnp.issubdtype(frames.dtype, jnp.integer):
+        raise TypeError(f"frames must be an int or an integer scalar array, got {frames.dtype} {frames.shape}")
+
+
+def _check_static_frames(frames, record_screens: bool) -> int:
+    try:
+        frames = operator.index(frames)
+    except TypeError:
+        raise TypeError(
+            f"frames must be a Python int (mark it static under jit){'' if record_screens else ' or an integer scalar array'}, "
+            f"got {type(frames).__name__}"
+        ) from None
+    if frames < 0:
+        raise ValueError(f"frames must be >= 0, got {frames}")
+    return frames

@@ -41,6 +41,9 @@ class EnvConfig:
             protocol uses 30). The start states are made once, at `make` (see `octax_core.env.starts`).
         autoreset: `step` starts a new episode as soon as one ends (same-step; the ended
             episode's last observation and info go in `info`), for `lax.scan` training loops.
+        skip_idle: fast-forward the rest of a frame once the program provably spins, and give
+            each env of a batch its own frame clock (`octax_core.emulator.idle`): the same
+            observations, rewards and flags, bit for bit, at a cost that follows the work.
     """
 
     frames_per_step: int = _option(4, check_int)
@@ -49,6 +52,7 @@ class EnvConfig:
     freeze_timers: bool = _option(False, check_bool)
     noop_max: int = _option(0, functools.partial(check_int, minimum=0))
     autoreset: bool = _option(False, check_bool)
+    skip_idle: bool = _option(True, check_bool)
 
 
 @jax.tree_util.register_dataclass

@@ -69,7 +69,8 @@ class Env:
         from octax_core.env.romstore import load_game_rom  # the store does file I/O: only at make
 
         self.spec, self.config = spec, config
-        self.machine = Machine(spec.platform, quirks=spec.quirks, instructions_per_frame=config.instructions_per_frame)
+        self.machine = Machine(spec.platform, quirks=spec.quirks, instructions_per_frame=config.instructions_per_frame,
+                               skip_idle=config.skip_idle)
         template = starts.boot(self.machine, load_game_rom(spec, rom_path), spec.startup)
         noop_step = _noop_stepper(self.machine, config.frames_per_step, config.freeze_timers)
         self._starts = starts.noop_pool(template, noop_step, config.noop_max)
@@ -219,7 +220,7 @@ def make(game: Union[str, GameSpec], *, rom=None, **options: Any) -> tuple[Env, 
         rom: an explicit ROM path (its SHA-1 must match the spec's).
         **options: `EnvConfig` and `EnvParams` fields (`octax_core.env.config.ENV_OPTIONS`:
             frames_per_step, instructions_per_frame, obs_scale, freeze_timers, noop_max,
-            autoreset, max_episode_steps, repeat_action_probability).
+            autoreset, skip_idle, max_episode_steps, repeat_action_probability).
 
     Raises:
         KeyError: unknown game id (the message lists the valid ids).

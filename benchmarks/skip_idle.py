@@ -1,0 +1,214 @@
+"""skip_idle on every registered game: env steps/s with it off and on, and proof they agree.
+
+For each game and batch size N, two envs are made, `octax_core.make(game, autoreset=True,
+skip_idle=False)` and the same with `skip_idle=True`, and each runs the same jitted rollout: N
+envs reset from one key, then `--steps` steps of `jax.vmap(env.step)` in a `lax.scan`, with
+uniform random actions drawn once (seeded) and shared by both sides. A timed run is one whole
+rollout (best of `--repeats`, the sides alternating; compile excluded). Both rollouts also return
+every step's reward and flags, a fingerprint of every step's observation (a position-weighted
+uint32 sum) and the final env state: `exact` says whether all of them are equal.
+
+    python benchmarks/skip_idle.py                                    # every game, N = 64
+    python benchmarks/skip_idle.py --games archive200 --envs 64,512   # the archive's >= 200 ipf games
+    python benchmarks/skip_idle.py --markdown docs/speed.md           # also write the table page
+
+One `BENCH skip_idle ...` line per (game, N), then one `BENCH skip_idle_summary ...` line per
+(group, N) with the geometric-mean speed-up, for the archive games at >= 200 instructions per
+frame and for all games measured.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import platform
+import sys
+import time
+from pathlib import Path
+from typing import Optional
+
+from harness import bench_line, load_average
+
+GROUPS = ("archive200", "archive", "octax", "ours", "all")
+
+
+def select_games(spec: str) -> list[str]:
+    import octax_core
+
+    if spec == "all":
+        return octax_core.list_games()
+    if spec == "archive200":
+        return [g for g in octax_core.list_games("archive") if (octax_core.get_spec(g).instructions_per_frame or 0) >= 200]
+    if spec in ("archive", "octax", "ours"):
+        return octax_core.list_games(spec)
+    games = [g.strip() for g in spec.split(",") if g.strip()]
+    for game in games:
+        octax_core.get_spec(game)  # raises KeyError naming the valid ids
+    return games
+
+
+def prepare(game: str, skip_idle: bool, num_envs: int, steps: int, seed: int):
+    """The compiled rollout of one side and its inputs; returns (run, compile_s, env)."""
+    import jax
+    import jax.numpy as jnp
+    import numpy as np
+
+    import octax_core
+
+    env, params = octax_core.make(game, autoreset=True, skip_idle=skip_idle)
+    weights = jnp.asarray(np.random.default_rng(0).integers(1, 2**31, env.observation_shape), jnp.uint32)
+
+    def rollout(key, actions):
+        _, state = jax.vmap(env.reset, in_axes=(0, None))(jax.random.split(key, num_envs), params)
+
+        def step(state, inputs):
+            keys, action = inputs
+            obs, state, reward, terminated, truncated, info = jax.vmap(env.step, in_axes=(0, 0, 0, None))(
+                keys, state, action, params)
+            fingerprint = jnp.sum(obs.astype(jnp.uint32) * weights, axis=(1, 2, 3), dtype=jnp.uint32)
+            return state, (fingerprint, reward, terminated, truncated, info["score"])
+
+        keys = jax.random.split(jax.random.fold_in(key, 1), (steps, num_envs))
+        return jax.lax.scan(step, state, (keys, actions))
+
+    actions = np.random.default_rng(seed).integers(0, env.num_actions, (steps, num_envs), dtype=np.int32)
+    key = jax.random.key(seed)
+    t0 = time.perf_counter()
+    compiled = jax.jit(rollout).lower(key, actions).compile()
+    return (lambda: compiled(key, actions)), time.perf_counter() - t0, env
+
+
+def measure(game: str, num_envs: int, steps: int, repeats: int, seed: int) -> dict:
+    import jax
+    import numpy as np
+
+    sides = {}
+    for skip_idle in (False, True):
+        run, compile_s, env = prepare(game, skip_idle, num_envs, steps, seed)
+        out = jax.block_until_ready(run())  # warm-up, and the trajectory compared below
+        sides[skip_idle] = dict(run=run, compile_s=compile_s, out=out, best=float("inf"))
+    for _ in range(repeats):
+        for side in sides.values():
+            t0 = time.perf_counter()
+            jax.block_until_ready(side["run"]())
+            side["best"] = min(side["best"], time.perf_counter() - t0)
+    exact = all(np.array_equal(np.asarray(a), np.asarray(b))
+                for a, b in zip(jax.tree.leaves(sides[False]["out"]), jax.tree.leaves(sides[True]["out"])))
+    spec = env.spec
+    plain_sps = steps * num_envs / sides[False]["best"]
+    skip_sps = steps * num_envs / sides[True]["best"]
+    return dict(game=game, suite=_suite(game), platform=spec.platform, ipf=env.config.instructions_per_frame,
+                n=num_envs, steps=steps, plain_sps=round(plain_sps), skip_sps=round(skip_sps),
+                speedup=round(skip_sps / plain_sps, 3), exact=exact,
+                compile_plain_s=round(sides[False]["compile_s"], 2), compile_skip_s=round(sides[True]["compile_s"], 2))
+
+
+def _suite(game: str) -> str:
+    from octax_core.env import suite_of
+
+    return suite_of(game)
+
+
+def geomean(values) -> float:
+    values = list(values)
+    return math.exp(sum(math.log(v) for v in values) / len(values)) if values else float("nan")
+
+
+def summaries(rows: list[dict]) -> list[dict]:
+    out = []
+    for n in sorted({r["n"] for r in rows}):
+        at_n = [r for r in rows if r["n"] == n]
+        groups = {"archive200": [r for r in at_n if r["suite"] == "archive" and r["ipf"] >= 200], "measured": at_n}
+        for group, members in groups.items():
+            if members:
+                out.append(dict(group=group, n=n, games=len(members),
+                                geomean_speedup=round(geomean(r["speedup"] for r in members), 3),
+                                min_speedup=min(r["speedup"] for r in members),
+                                max_speedup=max(r["speedup"] for r in members),
+                                exact="all" if all(r["exact"] for r in members) else "NOT"))
+    return out
+
+
+def markdown(rows: list[dict], command: str) -> str:
+    ns = sorted({r["n"] for r in rows})
+    by_game = {}
+    for r in rows:
+        by_game.setdefault(r["game"], {})[r["n"]] = r
+    lines = [
+        "# Speed with and without skip_idle",
+        "",
+        "Generated by `benchmarks/skip_idle.py` (do not edit by hand):",
+        "",
+        f"    {command}",
+        "",
+        f"Machine: {platform.processor() or platform.machine()}, {_cores()} cores, CPU only; "
+        f"JAX {_jax_version()}. Env steps per second (4 frames a step, random actions, same-step autoreset), "
+        "best of the timed runs; `exact`: every step's observation, reward and flags, and the final state, "
+        "equal with and without skip_idle. docs/machine.md says what skip_idle detects.",
+        "",
+    ]
+    head = "| game | suite | platform | ipf | " + " | ".join(f"N={n} off | N={n} on | N={n} x" for n in ns) + " | exact |"
+    lines += [head, "|" + "---|" * (head.count("|") - 1)]
+    for game in sorted(by_game, key=lambda g: (-by_game[g][ns[0]]["ipf"] if ns[0] in by_game[g] else 0, g)):
+        cells = by_game[game]
+        first = next(iter(cells.values()))
+        parts = [game, first["suite"], first["platform"], str(first["ipf"])]
+        for n in ns:
+            r = cells.get(n)
+            parts += ([f"{r['plain_sps']:,}", f"{r['skip_sps']:,}", f"{r['speedup']:.2f}"] if r else ["", "", ""])
+        parts.append("yes" if all(r["exact"] for r in cells.values()) else "NO")
+        lines.append("| " + " | ".join(parts) + " |")
+    lines += ["", "| group | N | games | geometric-mean speed-up | min | max | exact |", "|---|---|---|---|---|---|---|"]
+    for s in summaries(rows):
+        lines.append(f"| {s['group']} | {s['n']} | {s['games']} | {s['geomean_speedup']:.2f} | {s['min_speedup']:.2f} | "
+                     f"{s['max_speedup']:.2f} | {s['exact']} |")
+    return "\n".join(lines) + "\n"
+
+
+def _cores() -> int:
+    import os
+
+    return os.cpu_count() or 0
+
+
+def _jax_version() -> str:
+    import jax
+
+    return jax.__version__
+
+
+def main(argv: Optional[list[str]] = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--games", default="all",
+                        help=f"comma-separated ids, or one of {', '.join(GROUPS)} (default all)")
+    parser.add_argument("--envs", default="64", help="comma-separated batch sizes N (default 64)")
+    parser.add_argument("--steps", type=int, default=40, help="env steps per timed run (default 40)")
+    parser.add_argument("--repeats", type=int, default=3, help="timed runs per side, the best counts (default 3)")
+    parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--jsonl", type=Path, default=None, help="also append each row, as JSON, to this file")
+    parser.add_argument("--markdown", type=Path, default=None, help="write the table page (e.g. docs/speed.md)")
+    args = parser.parse_args(argv)
+    games = select_games(args.games)
+    ns = [int(n) for n in args.envs.split(",")]
+    rows = []
+    print(f"# {len(games)} games, N = {ns}, {args.steps} steps, best of {args.repeats}; load {load_average():.2f}",
+          flush=True)
+    for game in games:
+        for n in ns:
+            row = measure(game, n, args.steps, args.repeats, args.seed)
+            rows.append(row)
+            print(bench_line("skip_idle", row), flush=True)
+            if args.jsonl:
+                with args.jsonl.open("a") as f:
+                    f.write(json.dumps(row) + "\n")
+    for s in summaries(rows):
+        print(bench_line("skip_idle_summary", s), flush=True)
+    if args.markdown:
+        command = "python benchmarks/skip_idle.py " + " ".join(argv if argv is not None else sys.argv[1:])
+        args.markdown.write_text(markdown(rows, command.strip()))
+    return 0 if all(r["exact"] for r in rows) else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,78 @@
+"""Every registered game plays the same with skip_idle on and off: every observation, reward,
+flag and info value of a random-action rollout (with same-step autoreset, so episode ends and
+resets are inside it) must match bit for bit, from the same seed.
+
+`make test` checks a handful of games that cover the three platforms, the VIP's display wait and
+the archive's busiest and idlest programs; the whole registry is marked slow (CI runs it). skip_idle
+takes effect from `idle.SKIP_FROM` instructions per frame, so a game whose own rate is lower (the
+octax suite's 11) plays here at four times its rate: the same code, with the skipping path on.
+"""
+
+import functools
+
+import jax
+import numpy as np
+import pytest
+
+import octax_core
+from octax_core.emulator import idle
+
+NUM_ENVS = 2
+STEPS = 40
+FAST_GAMES = ["Pong", "Brix", "SuperPong", "Snek", "Danm8ku", "Piper", "SuperOctogon", "OctoPartyMix", "DodgeArchive"]
+SLOW_GAMES = [g for g in octax_core.list_games() if g not in FAST_GAMES]
+
+
+@functools.lru_cache(maxsize=None)
+def rollout(game: str, skip_idle: bool):
+    own = octax_core.get_spec(game).instructions_per_frame or 11
+    ipf = own if own >= idle.SKIP_FROM else 4 * own
+    env, params = octax_core.make(game, autoreset=True, skip_idle=skip_idle, instructions_per_frame=ipf)
+
+    def run(key, actions):
+        obs, state = jax.vmap(env.reset, in_axes=(0, None))(jax.random.split(key, NUM_ENVS), params)
+
+        def step(carry, inputs):
+            state, = carry
+            keys, action = inputs
+            out = jax.vmap(env.step, in_axes=(0, 0, 0, None))(keys, state, action, params)
+            obs, state, reward, terminated, truncated, info = out
+            return (state,), (obs, reward, terminated, truncated, info)
+
+        keys = jax.random.split(jax.random.fold_in(key, 1), (STEPS, NUM_ENVS))
+        (state,), trajectory = jax.lax.scan(step, (state,), (keys, actions))
+        return obs, trajectory, state
+
+    return env, jax.jit(run)
+
+
+def check_same_trajectory(game: str):
+    env, fast = rollout(game, True)
+    _, slow = rollout(game, False)
+    actions = np.random.default_rng(7).integers(0, env.num_actions, (STEPS, NUM_ENVS), dtype=np.int32)
+    key = jax.random.key(3)
+    a, b = fast(key, actions), slow(key, actions)
+    names = ["reset obs", "obs", "reward", "terminated", "truncated", "info", "final state"]
+    for name, x, y in zip(names, [a[0], *a[1], a[2]], [b[0], *b[1], b[2]]):
+        for (path, p), q in zip(jax.tree_util.tree_flatten_with_path(x)[0], jax.tree.leaves(y)):
+            assert np.array_equal(np.asarray(p), np.asarray(q)), f"{game}: {name}{jax.tree_util.keystr(path)} differs"
+
+
+@pytest.mark.parametrize("game", FAST_GAMES)
+def test_skip_idle_gives_the_same_trajectory(game, octax_rom_dir):
+    check_same_trajectory(game)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("game", SLOW_GAMES)
+def test_skip_idle_gives_the_same_trajectory_on_every_game(game, octax_rom_dir):
+    check_same_trajectory(game)
+
+
+def test_skip_idle_is_an_env_option():
+    env, _ = octax_core.make("Snek", skip_idle=False)
+    assert env.config.skip_idle is False and env.machine.skip_idle is False
+    env, _ = octax_core.make("Snek")
+    assert env.config.skip_idle is True and env.machine.skip_idle is True
+    with pytest.raises((TypeError, ValueError), match="skip_idle"):
+        octax_core.make("Snek", skip_idle=3)
