@@ -2,6 +2,7 @@
 # make test   run the test suite (all but the tests marked slow: about 15 minutes on 2 cores)
 # make test-slow  the slow tests: every archive game played, long ROM runs (CI runs both)
 # make bench  throughput of the core on Pong, against the octax package (benchmarks/README.md)
+# make bench-scaling  the scaling figure: octax-gym, octax, EnvPool and ale-py Pong against N (docs/scaling.md)
 # make wheel-check  the wheel in a clean venv, offline, empty HOME: every archive game builds and passes check_env
 # make roms   rebuild our own games, roms/*.ch8, from their Octo source roms/*.8o
 #
@@ -33,7 +34,7 @@ BENCH_ARGS  ?=
 # when they are all there already (a hash check of a few dozen small files).
 ROMS_READY := $(PY) -m octax_gym roms install --if-missing
 
-.PHONY: help demo test test-slow wheel-check bench roms clean
+.PHONY: help demo test test-slow wheel-check bench bench-scaling roms clean
 
 help:
 	@sed -n 's/^# \(make .*\)/\1/p' Makefile
@@ -56,6 +57,10 @@ wheel-check:
 bench: $(VENV)/.installed-dev
 	$(ROMS_READY)
 	$(PY) benchmarks/throughput.py $(BENCH_ARGS)
+
+bench-scaling: $(VENV)/.installed-dev $(VENV)/.installed-scaling
+	$(ROMS_READY)
+	$(PY) benchmarks/scaling.py $(BENCH_ARGS)
 
 # tests/core/test_own_roms.py checks that the committed ROMs are what this builds; a game's
 # GameSpec names its ROM's SHA-1, so update it after a rebuild that changes the bytes.

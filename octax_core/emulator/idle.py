@@ -28,7 +28,7 @@ paid per instruction: `jax.custom_batching.custom_vmap` gives the batched loop t
 from __future__ import annotations
 
 import functools
-from typing import Callable, NamedTuple
+from typing import Callable, NamedTuple, Optional
 
 import jax
 import jax.numpy as jnp
@@ -199,6 +199,22 @@ def _finish(state, clock: Clock, record_screens: bool):
 # repeats from one chunk's end to the next and is found two chunks after it starts; measured on
 # the archive's >= 200 ipf games at N = 64, 12 gave 3.6x where 8 gave 3.0x (docs/speed.md).
 CHUNK = 12
+SPIN_PERIODS = (2, 3, 4, 6)
+
+
+def chunk_size(instructions_per_frame: int) -> int:
+    """CHUNK, unless a busy frame would waste more than 3% of its slots in its last, partial chunk
+    (a frame of 30 runs 3 chunks of 12: 36 slots): then the divisor of the frame length between 5
+    and 16 that is a multiple of the most spin periods (the larger on a tie), if there is one."""
+    slots = -(-instructions_per_frame // CHUNK) * CHUNK
+    if slots - instructions_per_frame <= 0.03 * instructions_per_frame:
+        return min(CHUNK, instructions_per_frame)
+    divisors = [d for d in range(5, 17) if instructions_per_frame % d == 0]
+    if not divisors:
+        return min(CHUNK, instructions_per_frame)
+    return max(divisors, key=lambda d: (sum(d % p == 0 for p in SPIN_PERIODS), d))
+
+
 # Below this many instructions per frame a frame holds too little to skip for the clock to pay
 # (Pong at 11: 0.92x, Carbon8 at 15: 0.84x, SuperPong at 30: 1.05x), and `Machine` runs the
 # plain lockstep loop, whose results are the same.
@@ -207,12 +223,12 @@ SKIP_FROM = 25
 
 @functools.lru_cache(maxsize=None)
 def frame_runner(platform: Platform, quirks: Quirks, instructions_per_frame: int, frames: int,
-                 record_screens: bool, chunk: int = CHUNK):
+                 record_screens: bool, chunk: Optional[int] = None):
     """`run(state, keys, still) -> (state, screens or None)`: `frames` frames of one machine,
     skipping idle instructions; batch it with `jax.vmap` (its batching rule is the lockstep loop
     over every machine, see the module docstring). `still` (bool) marks a machine that does
     nothing this call (halted, or exited): its state comes back unchanged."""
-    chunk = min(chunk, instructions_per_frame)
+    chunk = chunk_size(instructions_per_frame) if chunk is None else min(chunk, instructions_per_frame)
     step = functools.partial(_step, _executor(platform, quirks), instructions_per_frame, chunk, frames,
                              quirks.display_wait)
     end_frame = functools.partial(_end_frame, instructions_per_frame, frames, record_screens)

@@ -207,3 +207,20 @@ def test_pure_kinds_are_the_ones_that_write_no_memory_and_no_screen():
 def test_skip_idle_is_checked():
     with pytest.raises((TypeError, ValueError), match="skip_idle"):
         octax_core.Machine("chip8", skip_idle="yes")
+
+
+def test_nested_vmap_and_a_single_machine_agree_with_the_plain_loop():
+    """The batching rule serves one vmap; an outer one (seeds x envs) batches what it returns, and a
+    machine outside any vmap runs the unbatched loop: all three give the plain loop's states."""
+    rom = assemble([set_delay(1, 3), delay_wait(2), draw(0, 1, 5, 7), key_spin(3, 5, False)], [0x6A07])
+    fast = octax_core.Machine("chip8", instructions_per_frame=50, skip_idle=True)
+    slow = octax_core.Machine("chip8", instructions_per_frame=50, skip_idle=False)
+    keys = np.array([[0, 1 << 5], [1 << 5, 0]], np.uint32)
+    seeds = jax.random.split(jax.random.key(1), 4).reshape(2, 2)
+    states = jax.vmap(jax.vmap(lambda k: slow.boot(rom, k)))(seeds)
+    run = lambda m: jax.jit(jax.vmap(jax.vmap(lambda s, k: m.run_frames(s, k, 3, record_screens=True))))
+    a, b = run(fast)(states, keys), run(slow)(states, keys)
+    assert first_mismatch(a, b) is None
+    single = jax.tree.map(lambda leaf: leaf[1, 0], states)
+    one = fast.run_frames(single, keys[1, 0], 3, record_screens=True)
+    assert first_mismatch(one, jax.tree.map(lambda leaf: leaf[1, 0], b)) is None
