@@ -104,6 +104,12 @@ def measure(game: str, num_envs: int, steps: int, repeats: int, seed: int) -> di
                 compile_plain_s=round(sides[False]["compile_s"], 2), compile_skip_s=round(sides[True]["compile_s"], 2))
 
 
+def octax_core_spec_ipf(game: str) -> int:
+    import octax_core
+
+    return octax_core.get_spec(game).instructions_per_frame or 11
+
+
 def _suite(game: str) -> str:
     from octax_core.env import suite_of
 
@@ -132,7 +138,8 @@ def summaries(rows: list[dict]) -> list[dict]:
 
 FOOTNOTE = ("Games under 25 instructions a frame (`octax_core.emulator.idle.SKIP_FROM`: the octax suite's games "
             "at 11, most archive games at 7 to 20) run the same plain program with skip_idle on or off, so their "
-            "speed does not change; `--games all` measures them too. Timings on the shared 2-core machine vary by "
+            "speed does not change, and the larger N (`--skipping-envs`, a `-` in their rows) is measured only "
+            "on the games where it takes effect. Timings on the shared 2-core machine vary by "
             "about +-10% from run to run; each row's two sides are timed alternately.")
 
 
@@ -164,6 +171,7 @@ def markdown(rows: list[dict], command: str) -> str:
             r = cells.get(n)
             parts += ([f"{r['plain_sps']:,}", f"{r['skip_sps']:,}", f"{r['speedup']:.2f}"] if r else ["", "", ""])
         parts.append("yes" if all(r["exact"] for r in cells.values()) else "NO")
+        parts = [p if p else "-" for p in parts]
         lines.append("| " + " | ".join(parts) + " |")
     lines += ["", "| group | N | games | geometric-mean speed-up | min | max | exact |", "|---|---|---|---|---|---|---|"]
     for s in summaries(rows):
@@ -190,6 +198,11 @@ def main(argv: Optional[list[str]] = None) -> int:
     parser.add_argument("--games", default="all",
                         help=f"comma-separated ids, or one of {', '.join(GROUPS)} (default all)")
     parser.add_argument("--envs", default="64", help="comma-separated batch sizes N (default 64)")
+    parser.add_argument("--skipping-envs", default="",
+                        help="more batch sizes, measured only on the games where skip_idle takes effect "
+                             "(>= idle.SKIP_FROM instructions a frame; the others run the same program either way)")
+    parser.add_argument("--skipping-steps", type=int, default=None,
+                        help="env steps per timed run at the --skipping-envs sizes (default: --steps)")
     parser.add_argument("--steps", type=int, default=40, help="env steps per timed run (default 40)")
     parser.add_argument("--repeats", type=int, default=3, help="timed runs per side, the best counts (default 3)")
     parser.add_argument("--seed", type=int, default=0)
@@ -198,12 +211,17 @@ def main(argv: Optional[list[str]] = None) -> int:
     args = parser.parse_args(argv)
     games = select_games(args.games)
     ns = [int(n) for n in args.envs.split(",")]
+    more = [int(n) for n in args.skipping_envs.split(",") if n.strip()]
     rows = []
     print(f"# {len(games)} games, N = {ns}, {args.steps} steps, best of {args.repeats}; load {load_average():.2f}",
           flush=True)
+    from octax_core.emulator.idle import SKIP_FROM
+
     for game in games:
-        for n in ns:
-            row = measure(game, n, args.steps, args.repeats, args.seed)
+        skipping = (octax_core_spec_ipf(game)) >= SKIP_FROM
+        for n in ns + (more if skipping else []):
+            steps = args.skipping_steps if n in more and n not in ns and args.skipping_steps else args.steps
+            row = measure(game, n, steps, args.repeats, args.seed)
             rows.append(row)
             print(bench_line("skip_idle", row), flush=True)
             if args.jsonl:
@@ -212,7 +230,10 @@ def main(argv: Optional[list[str]] = None) -> int:
     for s in summaries(rows):
         print(bench_line("skip_idle_summary", s), flush=True)
     if args.markdown:
-        command = "python benchmarks/skip_idle.py " + " ".join(argv if argv is not None else sys.argv[1:])
+        given = list(argv if argv is not None else sys.argv[1:])
+        if "--jsonl" in given:  # where a copy of the rows went is not part of what was measured
+            del given[given.index("--jsonl"):given.index("--jsonl") + 2]
+        command = "python benchmarks/skip_idle.py " + " ".join(given)
         args.markdown.write_text(markdown(rows, command.strip()))
     return 0 if all(r["exact"] for r in rows) else 1
 
