@@ -224,3 +224,14 @@ def test_nested_vmap_and_a_single_machine_agree_with_the_plain_loop():
     single = jax.tree.map(lambda leaf: leaf[1, 0], states)
     one = fast.run_frames(single, keys[1, 0], 3, record_screens=True)
     assert first_mismatch(one, jax.tree.map(lambda leaf: leaf[1, 0], b)) is None
+
+
+def test_chunk_size_wastes_little_of_a_busy_frame():
+    """The chunk is 12 unless a busy frame would waste over 3% of its slots in its last partial
+    chunk; then it divides the frame (30 -> 6, 100 -> 10)."""
+    assert idle.chunk_size(1000) == idle.chunk_size(200) == 12
+    assert idle.chunk_size(30) == 6 and idle.chunk_size(100) == 10 and idle.chunk_size(44) == 11
+    for ipf in range(idle.SKIP_FROM, 2000):
+        chunk = idle.chunk_size(ipf)
+        slots = -(-ipf // chunk) * chunk
+        assert slots - ipf <= 0.03 * ipf or ipf % chunk == 0 or not any(ipf % d == 0 for d in range(5, 17)), ipf
