@@ -213,8 +213,8 @@ def main(argv: Optional[list[str]] = None) -> int:
     parser.add_argument("--jsonl", type=Path, default=None, help="also append each row, as JSON, to this file")
     parser.add_argument("--markdown", type=Path, default=None, help="write the table page (e.g. docs/speed.md)")
     parser.add_argument("--include", type=Path, action="append", default=[],
-                        help="rows of an earlier run (its --jsonl file) to put on the page too; this run's rows "
-                             "replace theirs for the same game and N")
+                        help="rows of an earlier run (its --jsonl file) to put on the page too; a later --include, "
+                             "then this run, replaces an earlier row for the same game and N")
     args = parser.parse_args(argv)
     given = list(argv if argv is not None else sys.argv[1:])
     for local in ("--jsonl", "--include"):  # where rows were copied or merged from: not what was measured
@@ -243,9 +243,11 @@ def main(argv: Optional[list[str]] = None) -> int:
     for s in summaries(rows):
         print(bench_line("skip_idle_summary", s), flush=True)
     if args.markdown:
-        mine = {(r["game"], r["n"]) for r in rows}
         earlier = [json.loads(line) for path in args.include for line in path.read_text().splitlines() if line.strip()]
-        page_rows = [r for r in earlier if (r["game"], r["n"]) not in mine] + rows
+        merged = {}  # a later include, then this run, replaces an earlier row for the same game and N
+        for row in earlier + rows:
+            merged[(row["game"], row["n"])] = row
+        page_rows = list(merged.values())
         if args.include:
             for s in summaries(page_rows):
                 print(bench_line("skip_idle_summary_page", s), flush=True)

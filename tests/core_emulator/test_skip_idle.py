@@ -228,9 +228,9 @@ def test_nested_vmap_and_a_single_machine_agree_with_the_plain_loop():
 
 def test_chunk_size_wastes_little_of_a_busy_frame():
     """The chunk is 12 unless a busy frame would waste over 3% of its slots in its last partial
-    chunk; then it divides the frame (30 -> 6, 100 -> 10)."""
+    chunk; then it divides the frame (30 -> 15, 100 -> 10)."""
     assert idle.chunk_size(1000) == idle.chunk_size(200) == 12
-    assert idle.chunk_size(30) == 6 and idle.chunk_size(100) == 10 and idle.chunk_size(44) == 11
+    assert idle.chunk_size(30) == 15 and idle.chunk_size(100) == 10 and idle.chunk_size(44) == 11
     for ipf in range(idle.SKIP_FROM, 2000):
         chunk = idle.chunk_size(ipf)
         slots = -(-ipf // chunk) * chunk
