@@ -28,7 +28,7 @@ import time
 from pathlib import Path
 from typing import Optional
 
-from harness import bench_line, load_average
+from harness import Prepared, Progress, bench_line, load_average, time_interleaved
 
 GROUPS = ("archive200", "skipping", "plain", "archive", "octax", "ours", "all")
 
@@ -39,11 +39,11 @@ def select_games(spec: str) -> list[str]:
     if spec == "all":
         return octax_core.list_games()
     if spec == "archive200":
-        return [g for g in octax_core.list_games("archive") if (octax_core.get_spec(g).instructions_per_frame or 0) >= 200]
+        return [g for g in octax_core.list_games("archive") if game_ipf(g) >= 200]
     if spec in ("skipping", "plain"):  # where skip_idle takes effect (>= idle.SKIP_FROM ipf), and the rest
         from octax_core.emulator.idle import SKIP_FROM
 
-        return [g for g in octax_core.list_games() if (octax_core_spec_ipf(g) >= SKIP_FROM) == (spec == "skipping")]
+        return [g for g in octax_core.list_games() if (game_ipf(g) >= SKIP_FROM) == (spec == "skipping")]
     if spec in ("archive", "octax", "ours"):
         return octax_core.list_games(spec)
     games = [g.strip() for g in spec.split(",") if g.strip()]
@@ -52,8 +52,17 @@ def select_games(spec: str) -> list[str]:
     return games
 
 
-def prepare(game: str, skip_idle: bool, num_envs: int, steps: int, seed: int):
-    """The compiled rollout of one side and its inputs; returns (run, compile_s, env)."""
+def game_ipf(game: str) -> int:
+    """The instructions per frame `make(game)` runs at: the game's own, else the env default."""
+    from octax_core.env.config import make_config
+    from octax_core.env.games import get_spec
+
+    return make_config(get_spec(game))[0].instructions_per_frame
+
+
+def prepare(game: str, skip_idle: bool, num_envs: int, steps: int, seed: int) -> tuple[Prepared, dict, object]:
+    """One side, compiled: its `Prepared` (whose run also keeps its latest output in `outputs`,
+    every run's being the same) and the env."""
     import jax
     import jax.numpy as jnp
     import numpy as np
@@ -80,44 +89,35 @@ def prepare(game: str, skip_idle: bool, num_envs: int, steps: int, seed: int):
     key = jax.random.key(seed)
     t0 = time.perf_counter()
     compiled = jax.jit(rollout).lower(key, actions).compile()
-    return (lambda: compiled(key, actions)), time.perf_counter() - t0, env
+    outputs = {}
+
+    def run():
+        outputs["last"] = compiled(key, actions)
+        return outputs["last"]
+
+    side = Prepared(run=run, compile_s=time.perf_counter() - t0, state_bytes=0,
+                    instructions_per_step=env.config.frames_per_step * env.config.instructions_per_frame)
+    return side, outputs, env
 
 
 def measure(game: str, num_envs: int, steps: int, repeats: int, seed: int) -> dict:
     import jax
     import numpy as np
 
-    sides = {}
-    for skip_idle in (False, True):
-        run, compile_s, env = prepare(game, skip_idle, num_envs, steps, seed)
-        out = jax.block_until_ready(run())  # warm-up, and the trajectory compared below
-        sides[skip_idle] = dict(run=run, compile_s=compile_s, out=out, best=float("inf"))
-    for _ in range(repeats):
-        for side in sides.values():
-            t0 = time.perf_counter()
-            jax.block_until_ready(side["run"]())
-            side["best"] = min(side["best"], time.perf_counter() - t0)
-    exact = all(np.array_equal(np.asarray(a), np.asarray(b))
-                for a, b in zip(jax.tree.leaves(sides[False]["out"]), jax.tree.leaves(sides[True]["out"])))
-    spec = env.spec
-    plain_sps = steps * num_envs / sides[False]["best"]
-    skip_sps = steps * num_envs / sides[True]["best"]
-    return dict(game=game, suite=_suite(game), platform=spec.platform, ipf=env.config.instructions_per_frame,
-                n=num_envs, steps=steps, plain_sps=round(plain_sps), skip_sps=round(skip_sps),
-                speedup=round(skip_sps / plain_sps, 3), exact=exact,
-                compile_plain_s=round(sides[False]["compile_s"], 2), compile_skip_s=round(sides[True]["compile_s"], 2))
-
-
-def octax_core_spec_ipf(game: str) -> int:
-    import octax_core
-
-    return octax_core.get_spec(game).instructions_per_frame or 11
-
-
-def _suite(game: str) -> str:
     from octax_core.env import suite_of
 
-    return suite_of(game)
+    sides, outputs = {}, {}
+    for skip_idle in (False, True):
+        sides[skip_idle], outputs[skip_idle], env = prepare(game, skip_idle, num_envs, steps, seed)
+    time_interleaved(sides, repeats, Progress(0, enabled=False), game)
+    exact = all(np.array_equal(np.asarray(a), np.asarray(b))
+                for a, b in zip(jax.tree.leaves(outputs[False]["last"]), jax.tree.leaves(outputs[True]["last"])))
+    plain_sps = steps * num_envs / sides[False].best_s
+    skip_sps = steps * num_envs / sides[True].best_s
+    return dict(game=game, suite=suite_of(game), platform=env.spec.platform, ipf=env.config.instructions_per_frame,
+                n=num_envs, steps=steps, plain_sps=round(plain_sps), skip_sps=round(skip_sps),
+                speedup=round(skip_sps / plain_sps, 3), exact=exact,
+                compile_plain_s=round(sides[False].compile_s, 2), compile_skip_s=round(sides[True].compile_s, 2))
 
 
 def geomean(values) -> float:
@@ -230,7 +230,7 @@ def main(argv: Optional[list[str]] = None) -> int:
     from octax_core.emulator.idle import SKIP_FROM
 
     for game in games:
-        skipping = (octax_core_spec_ipf(game)) >= SKIP_FROM
+        skipping = game_ipf(game) >= SKIP_FROM
         for n in ns + (more if skipping else []):
             steps = args.skipping_steps if n in more and n not in ns and args.skipping_steps else args.steps
             row = measure(game, n, steps, args.repeats, args.seed)

@@ -88,8 +88,9 @@ class Clock(NamedTuple):
     screens: jax.Array  # (frames, *screen) uint32, the screen at each frame's end (or a dummy)
 
 
-def _start(state, instructions_per_frame: int, frames: int, record_screens: bool, still) -> Clock:
-    """The clock of a machine at the call's start; a `still` machine (halted, or after 00FD) is done."""
+def _start(state, instructions_per_frame: int, frames: int, record_screens: bool, halted) -> Clock:
+    """The clock of a machine at the call's start; a halted machine, or one after 00FD, is done."""
+    still = halted if state.exited is None else halted | state.exited
     zero = jnp.zeros_like(state.pc, dtype=jnp.int32)
     screens = jnp.zeros((frames if record_screens else 1, *state.screen.shape), state.screen.dtype)
     return Clock(frame=jnp.where(still, frames, 0).astype(jnp.int32), count=zero, target=zero + instructions_per_frame,
@@ -222,27 +223,29 @@ SKIP_FROM = 25
 @functools.lru_cache(maxsize=None)
 def frame_runner(platform: Platform, quirks: Quirks, instructions_per_frame: int, frames: int,
                  record_screens: bool, chunk: Optional[int] = None):
-    """`run(state, keys, still) -> (state, screens or None)`: `frames` frames of one machine,
+    """`run(state, keys, halted) -> (state, screens or None)`: `frames` frames of one machine,
     skipping idle instructions; batch it with `jax.vmap` (its batching rule is the lockstep loop
-    over every machine, see the module docstring). `still` (bool) marks a machine that does
-    nothing this call (halted, or exited): its state comes back unchanged."""
+    over every machine, see the module docstring). A `halted` machine (bool), like one after
+    00FD, does nothing this call: its state comes back unchanged."""
     chunk = chunk_size(instructions_per_frame) if chunk is None else min(chunk, instructions_per_frame)
     step = functools.partial(_step, _executor(platform, quirks), instructions_per_frame, chunk, frames,
                              quirks.display_wait)
     end_frame = functools.partial(_end_frame, instructions_per_frame, frames, record_screens)
 
     @jax.custom_batching.custom_vmap
-    def run(state, keys, still):
-        carry = (state, _start(state, instructions_per_frame, frames, record_screens, still))
+    def run(state, keys, halted):
+        carry = (state, _start(state, instructions_per_frame, frames, record_screens, halted))
         state, clock = jax.lax.while_loop(lambda c: c[1].frame < frames,
                                           functools.partial(_loop_body, step, end_frame, False, keys), carry)
         return _finish(state, clock, record_screens)
 
     @run.def_vmap
-    def run_batched(axis_size, in_batched, state, keys, still):
-        state, keys, still = (_broadcast(tree, batched, axis_size)
-                              for tree, batched in zip((state, keys, still), in_batched))
-        carry = (state, jax.vmap(lambda s, q: _start(s, instructions_per_frame, frames, record_screens, q))(state, still))
+    def run_batched(axis_size, in_batched, state, keys, halted):
+        state, keys, halted = (_broadcast(tree, batched, axis_size)
+                               for tree, batched in zip((state, keys, halted), in_batched))
+        start = functools.partial(_start, instructions_per_frame=instructions_per_frame, frames=frames,
+                                  record_screens=record_screens)
+        carry = (state, jax.vmap(lambda s, h: start(s, halted=h))(state, halted))
         state, clock = jax.lax.while_loop(lambda c: jnp.any(c[1].frame < frames),
                                           functools.partial(_loop_body, step, end_frame, True, keys), carry)
         out = jax.vmap(lambda s, c: _finish(s, c, record_screens))(state, clock)

@@ -133,17 +133,14 @@ class Machine:
 
     def _run_frames_skipping(self, state: MachineState, mask, frames, halted, record_screens: bool):
         """`run_frames` with idle instructions skipped (`octax_core.emulator.idle`)."""
-        still = jnp.zeros_like(state.pc, dtype=jnp.bool_) if halted is None else jnp.asarray(halted, jnp.bool_)
-        if state.exited is not None:
-            still = still | state.exited
+        halted = jnp.zeros_like(state.pc, dtype=jnp.bool_) if halted is None else jnp.asarray(halted, jnp.bool_)
         if isinstance(frames, jax.Array) and not record_screens:
             _check_traced_frames(frames)
             one = idle.frame_runner(self.platform, self.quirks, self.instructions_per_frame, 1, False)
-            still_now = lambda state: still if state.exited is None else still | state.exited
-            return jax.lax.fori_loop(0, frames, lambda _, state: one(state, mask, still_now(state))[0], state)
+            return jax.lax.fori_loop(0, frames, lambda _, state: one(state, mask, halted)[0], state)
         frames = _check_static_frames(frames, record_screens)
         run = idle.frame_runner(self.platform, self.quirks, self.instructions_per_frame, frames, record_screens)
-        state, screens = run(state, mask, still)
+        state, screens = run(state, mask, halted)
         return (state, screens) if record_screens else state
 
 

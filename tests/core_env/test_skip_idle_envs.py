@@ -16,6 +16,7 @@ import pytest
 
 import octax_core
 from octax_core.emulator import idle
+from octax_core.env.config import make_config
 
 NUM_ENVS = 2
 STEPS = 40
@@ -25,7 +26,7 @@ SLOW_GAMES = [g for g in octax_core.list_games() if g not in FAST_GAMES]
 
 @functools.lru_cache(maxsize=None)
 def rollout(game: str, skip_idle: bool):
-    own = octax_core.get_spec(game).instructions_per_frame or 11
+    own = make_config(octax_core.get_spec(game))[0].instructions_per_frame
     ipf = own if own >= idle.SKIP_FROM else 4 * own
     env, params = octax_core.make(game, autoreset=True, skip_idle=skip_idle, instructions_per_frame=ipf)
 
