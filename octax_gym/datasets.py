@@ -1,0 +1,405 @@
+"""Offline datasets: play a game in many lanes at once and store every episode as a Minari dataset.
+
+    from octax_gym.datasets import collect_dataset, episode_seed
+    result = collect_dataset("Brix", "octax/Brix-random-v0", num_steps=100_000, num_envs=64)
+    dataset = result.dataset                       # the same as minari.load_dataset("octax/Brix-random-v0")
+
+Minari's own `DataCollector` wraps one env and steps it alone. Here all `num_envs` lanes step in
+one jitted call, the compiled program behind `OctaxEnv` and `OctaxVectorEnv`
+(`octax_gym.program`), and each lane's episode is gathered on the host until it ends. A lane
+whose episode ends is reset in the same call with the next unused seed, so every episode, not
+just each lane's first, starts the way `OctaxEnv.reset(seed=s)` starts: from the key chain of
+its own seed s. `dataset.recover_environment()`, reset with an episode's seed (`episode_seed`)
+and stepped with its actions, gives back its observations, rewards and flags bit for bit. See
+docs/datasets.md.
+
+Minari is the optional `datasets` extra: it is imported inside the functions here, so
+`import octax_gym` works without it.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import functools
+import shutil
+import time
+import warnings
+from pathlib import Path
+from typing import Any, Callable, Optional, Union
+
+import gymnasium
+import jax
+import jax.numpy as jnp
+import numpy as np
+from gymnasium import spaces
+from gymnasium.vector import AutoresetMode
+from tqdm import tqdm
+
+from octax_core.validate import check_int
+from octax_gym import action_check, program
+from octax_gym.program import GYM_ENV_OPTIONS, MAX_SEED
+from octax_gym.video import resolve_env_id
+
+# A policy maps the batched observation, uint8 (num_envs, frames_per_step, H, W), to one action
+# per env (ints in 0..n-1, shape (num_envs,)).
+Policy = Union[None, str, Callable[[np.ndarray], Any]]
+
+FLUSH_STEPS = 20_000  # finished episodes are written once they hold this many steps (~160 MB of CHIP-8 frames)
+INSTALL_HINT = 'pip install "octax-gym[datasets]"'
+
+
+@dataclasses.dataclass(frozen=True)
+class CollectResult:
+    """What `collect_dataset` made: the dataset, and how long collecting and writing it took."""
+
+    dataset: Any  # minari.MinariDataset
+    dataset_id: str
+    path: Path  # the dataset's folder (its data/ holds main_data.hdf5 and metadata.json)
+    episodes: int
+    steps: int
+    seconds: float  # wall time of stepping, policy and writing, the first steps' JAX compile included
+
+    @property
+    def steps_per_second(self) -> float:
+        return self.steps / self.seconds if self.seconds > 0 else float("inf")
+
+
+def collect_dataset(env_id: str, dataset_id: str, num_steps: int, *, num_envs: int = 64,
+                    policy: Policy = None, seed: int = 0, overwrite: bool = False, progress: bool = True,
+                    author: Optional[str] = None, author_email: Optional[str] = None,
+                    code_permalink: Optional[str] = None, description: Optional[str] = None,
+                    flush_steps: int = FLUSH_STEPS, **env_options) -> CollectResult:
+    """Plays `num_steps` env steps in `num_envs` lanes at once and writes them as a Minari dataset.
+
+    Episodes end where the env ends them (terminated, or truncated at max_episode_steps); the
+    episodes still running when `num_steps` is reached are stored cut there, truncated=True at
+    their last step. Each episode stores T + 1 observations (uint8, exact: no JPEG), T actions,
+    rewards, terminations, truncations, and T + 1 infos (score, lives, episode_step; the first
+    from the reset), and its reset seed (`episode_seed`). The lanes' first episodes get seeds
+    seed .. seed + num_envs - 1, then every new episode the next unused seed. The same
+    arguments give the same dataset.
+
+    Args:
+        env_id: a game id ("Brix") or its Gymnasium id ("octax/Brix-v0").
+        dataset_id: Minari's `namespace/name-vN` (namespace optional; letters, digits, '-', '_';
+            the version -vN is required), written under MINARI_DATASETS_PATH (default
+            ~/.minari/datasets).
+        num_steps: transitions to store in all, >= 1 (the last batched step may fill only some lanes).
+        num_envs: lanes stepped together, >= 1.
+        policy: None or "random" (uniform actions drawn from `seed`), "noop" (action 0), or a
+            function from the batched observation, numpy uint8 (num_envs, frames_per_step, H, W),
+            to one action per lane (ints in 0..n-1, shape (num_envs,)), e.g. a trained agent.
+        seed: the first episode seed, 0 <= seed and seed + num_envs + num_steps <= 2**32.
+        overwrite: replace a dataset of that id; otherwise an existing one is an error.
+        progress: a tqdm progress bar on stderr.
+        author, author_email, code_permalink, description: Minari's metadata (the description
+            defaults to one naming the game, policy, lanes and seed).
+        flush_steps: finished episodes are written in groups of at least this many steps, which
+            bounds the memory they hold.
+        **env_options: the env's options (`octax_gym.program.GYM_ENV_OPTIONS`: max_episode_steps,
+            frames_per_step, noop_max, repeat_action_probability, ...); they are stored in the
+            dataset's env spec, so `recover_environment()` builds the same env.
+
+    Returns:
+        A `CollectResult`: the `minari.MinariDataset`, its id and folder, episodes, steps, seconds.
+
+    Raises:
+        ValueError: an unknown game or env option, a malformed or existing dataset id, bad
+            num_steps, num_envs, seed or policy name, or a policy returning a wrong batch of
+            actions; each message names the valid choices.
+        ImportError: Minari (the `datasets` extra) is not installed.
+    """
+    minari = _import_minari()
+    gym_id = resolve_env_id(env_id)
+    check_int("num_steps", num_steps)
+    check_int("num_envs", num_envs)
+    check_int("seed", seed, minimum=0, maximum=MAX_SEED - num_envs - num_steps)
+    check_int("flush_steps", flush_steps)
+    _check_dataset_id(dataset_id)
+    _check_env_options(env_options)
+    path = minari.storage.get_dataset_path(dataset_id)
+    if path.exists() and not overwrite:
+        raise ValueError(f"dataset {dataset_id!r} already exists at {path}; pass overwrite=True "
+                         "(--overwrite) to replace it, or pick another name or version")
+    lanes = _Lanes(gymnasium.spec(gym_id).kwargs["game"], num_envs, env_options)  # checks the options' values
+    act = _make_policy(policy, num_envs, lanes.num_actions, seed)
+    metadata = {"algorithm_name": _policy_name(policy), "author": author, "author_email": author_email,
+                "code_permalink": code_permalink,
+                "description": description or (f"{gym_id}, {_policy_name(policy)} policy, {num_steps} steps from "
+                                               f"{num_envs} lanes, episode seeds from {seed}: collected by "
+                                               "octax_gym.datasets.collect_dataset")}
+    if path.exists():
+        shutil.rmtree(path)
+    try:
+        start = time.perf_counter()
+        writer = _Writer(minari, dataset_id, recovery_spec(gym_id, env_options), lanes, flush_steps, metadata)
+        with tqdm(total=num_steps, desc=f"collecting {gym_id}", unit="step", disable=not progress) as bar:
+            _collect(lanes, act, num_steps, seed, writer, bar)
+        dataset = writer.close()
+        seconds = time.perf_counter() - start
+    except BaseException:
+        shutil.rmtree(path, ignore_errors=True)  # no half-written dataset left behind
+        raise
+    return CollectResult(dataset=dataset, dataset_id=dataset_id, path=Path(path), episodes=writer.episodes,
+                         steps=writer.steps, seconds=seconds)
+
+
+def recovery_spec(gym_id: str, env_options: dict) -> gymnasium.envs.registration.EnvSpec:
+    """The registered spec with the env options in its kwargs, so `gymnasium.make(spec)` (and
+    Minari's `recover_environment`) builds the env the data came from.
+
+    `max_episode_steps` goes into the kwargs, to the env's own truncation, and not into the
+    spec's field of that name, which would add Gymnasium's `TimeLimit` wrapper instead.
+    """
+    spec = gymnasium.spec(gym_id)
+    return dataclasses.replace(spec, kwargs={**spec.kwargs, **env_options})
+
+
+def episode_seed(dataset, episode_id: int) -> int:
+    """The seed of one stored episode: `env.reset(seed=episode_seed(dataset, i))` on the
+    recovered env starts episode i, and its actions then replay it exactly."""
+    (metadata,) = dataset.storage.get_episode_metadata([episode_id])
+    if metadata.get("seed") is None:
+        raise ValueError(f"episode {episode_id} of {dataset.id!r} has no stored seed")
+    return int(metadata["seed"])
+
+
+# --- the collection loop ---------------------------------------------------------------------
+
+
+class _Episode:
+    """One lane's running episode: its seed and what the env returned since the reset that
+    started it (numpy rows copied out of the batch, so a finished batch can be freed)."""
+
+    def __init__(self, seed: int, obs: np.ndarray, info: dict[str, Any]):
+        self.seed = seed
+        self.observations = [obs.copy()]
+        self.infos = {name: [value] for name, value in info.items()}
+        self.actions, self.rewards, self.terminations, self.truncations = [], [], [], []
+
+    def add(self, action, obs, reward, terminated, truncated, info: dict[str, Any]) -> None:
+        self.actions.append(action)
+        self.observations.append(obs.copy())
+        self.rewards.append(reward)
+        self.terminations.append(terminated)
+        self.truncations.append(truncated)
+        for name, value in info.items():
+            self.infos[name].append(value)
+
+    def __len__(self) -> int:
+        return len(self.actions)
+
+    def to_buffer(self, episode_buffer_class, cut: bool):
+        """A Minari `EpisodeBuffer`; `cut` marks an episode stopped by the end of collection
+        (truncated at its last step, which the env itself did not end)."""
+        truncations = np.array(self.truncations, np.bool_)
+        if cut:
+            truncations[-1] = True
+        return episode_buffer_class(
+            seed=self.seed, observations=np.stack(self.observations), actions=np.array(self.actions, np.int64),
+            rewards=np.array(self.rewards, np.float32), terminations=np.array(self.terminations, np.bool_),
+            truncations=truncations, infos={name: np.array(values) for name, values in self.infos.items()})
+
+
+def _collect(lanes: "_Lanes", act: Callable[[np.ndarray], Any], num_steps: int, seed: int,
+             writer: "_Writer", bar: tqdm) -> None:
+    """Steps every lane at once until `num_steps` transitions are stored, starting a new episode
+    in a lane, with the next unused seed, as soon as its episode ends."""
+    num_envs = lanes.num_envs
+    obs, info = lanes.start(seed)  # lane i: seed + i
+    episodes = [_Episode(seed + lane, obs[lane], _row(info, lane)) for lane in range(num_envs)]
+    next_seed = seed + num_envs
+    left = num_steps
+    while left > 0:
+        actions = _check_actions(act(obs), num_envs, lanes.num_actions, lanes.game)
+        last, reward, terminated, truncated, info, obs, first_info, seeds = lanes.step(actions, next_seed)
+        used = min(num_envs, left)  # the last batched step may fill only the first lanes
+        for lane in range(used):
+            episodes[lane].add(int(actions[lane]), last[lane], float(reward[lane]), bool(terminated[lane]),
+                               bool(truncated[lane]), _row(info, lane))
+        left -= used
+        bar.update(used)
+        for lane in np.flatnonzero(terminated | truncated):
+            next_seed += 1
+            if lane < used:
+                writer.add(episodes[lane], cut=False)
+                episodes[lane] = _Episode(int(seeds[lane]), obs[lane], _row(first_info, lane))
+    for episode in episodes:
+        if len(episode) and not (episode.terminations[-1] or episode.truncations[-1]):
+            writer.add(episode, cut=True)
+
+
+class _Lanes:
+    """`num_envs` lanes of one game driven by the compiled program behind `OctaxEnv` and
+    `OctaxVectorEnv` (`octax_gym.program`), with the envs' key derivation, in one jitted call
+    per step: the batched step, then a reset of each lane whose episode just ended.
+
+    Seeds flow as in the envs: a lane reset with seed s starts its key chain at
+    `jax.random.key(s)` and resets with the key's first split, exactly as `OctaxEnv.reset(seed=s)`
+    (or a vector env's masked `reset`) does, and every step splits the lane's key alone. The
+    lanes ending in a step take the seeds next_seed, next_seed + 1, ... in lane order.
+    """
+
+    def __init__(self, game: str, num_envs: int, env_options: dict):
+        self.program, self.params = program.build(game, None, env_options)
+        core = self.program.env
+        self.num_envs, self.game, self.num_actions = num_envs, core.spec.id, core.num_actions
+        self.observation_space = spaces.Box(0, core.observation_high, core.observation_shape, np.uint8)
+        self._step = _step_and_reset(self.program)
+        self._keys = self._state = None
+
+    def start(self, seed: int) -> tuple[np.ndarray, dict]:
+        """Resets lane i with seed + i; returns the observations and infos (numpy)."""
+        keys = program.keys_from_seeds(program.seeds_for(seed, self.num_envs))
+        self._keys, obs, self._state, info = self.program.reset(keys, None, None, None, self.params)
+        return jax.device_get((obs, _unmasked(info)))
+
+    def step(self, actions: np.ndarray, next_seed: int):
+        """Returns (as numpy) each lane's observation, reward, terminated, truncated and info
+        after the step, then the observation and info each lane goes on from (a new episode's
+        first where one ended), and the seed of each new episode (where one ended)."""
+        self._keys, self._state, outputs = self._step(
+            self._keys, self._state, jnp.asarray(actions, jnp.int32), jnp.uint32(next_seed), self.params)
+        return jax.device_get(outputs)
+
+
+@functools.lru_cache(maxsize=16)
+def _step_and_reset(compiled: program.Program):
+    """The lanes' jitted step for one game and config (cached, like the program: one compile per
+    batch size)."""
+    def step_and_reset(keys, state, actions, next_seed, params):
+        keys, last, state, reward, terminated, truncated, info, _ = compiled.step[AutoresetMode.DISABLED](
+            keys, state, actions, jnp.asarray(action_check.NO_REPORT, jnp.int32), params)
+        ended = terminated | truncated
+        seeds = next_seed + jnp.cumsum(ended, dtype=jnp.uint32) - 1  # lane order
+        keys = program.select_keys(ended, program.keys_from_seeds(seeds), keys)
+        keys, obs, state, first_info = compiled.reset(keys, state, last, ended, params)
+        return keys, state, (last, reward, terminated, truncated, _unmasked(info), obs, _unmasked(first_info),
+                             seeds)
+
+    return jax.jit(step_and_reset, donate_argnums=(1,))
+
+
+def _unmasked(info: dict) -> dict:
+    """The info (score, lives, episode_step) without Gymnasium's `_name` masks."""
+    return {name: value for name, value in info.items() if not name.startswith("_")}
+
+
+def _row(info: dict, lane: int) -> dict[str, Any]:
+    """One lane's info."""
+    return {name: value[lane] for name, value in info.items()}
+
+
+class _Writer:
+    """Creates the dataset, then appends finished episodes in groups of at least `flush_steps`
+    steps, so memory holds one group at a time.
+
+    (A writer thread overlapping HDF5 writes with the steps measured no faster on 2 cores.)
+    """
+
+    def __init__(self, minari, dataset_id: str, env_spec, lanes: _Lanes, flush_steps: int,
+                 metadata: dict[str, Any]):
+        self._episode_buffer = minari.data_collector.EpisodeBuffer
+        self._flush_steps = flush_steps
+        self._pending: list = []  # EpisodeBuffers not yet written
+        self._pending_steps = 0
+        self.episodes = self.steps = 0
+        given = {name: value for name, value in metadata.items() if value is not None}
+        with warnings.catch_warnings():  # Minari's "author is None, recommended" notes: optional here
+            warnings.filterwarnings("ignore", message=r".*is set to None", category=UserWarning)
+            self._dataset = minari.create_dataset_from_buffers(
+                dataset_id, [], env=env_spec, observation_space=lanes.observation_space,
+                action_space=spaces.Discrete(lanes.num_actions), requirements=["octax-gym"], data_format="hdf5",
+                jpeg_encoding=False, **given)
+
+    def add(self, episode: _Episode, cut: bool) -> None:
+        self._pending.append(episode.to_buffer(self._episode_buffer, cut))
+        self._pending_steps += len(episode)
+        if self._pending_steps >= self._flush_steps:
+            self._flush()
+
+    def close(self):
+        """Writes what is left; returns the `MinariDataset`."""
+        self._flush()
+        return self._dataset
+
+    def _flush(self) -> None:
+        if self._pending:
+            self._dataset.update_dataset_from_buffer(self._pending)
+            self.episodes += len(self._pending)
+            self.steps += self._pending_steps
+        self._pending, self._pending_steps = [], 0
+
+
+# --- checks and policies ---------------------------------------------------------------------
+
+
+def _import_minari():
+    try:
+        import minari
+        import minari.data_collector
+        import minari.storage
+    except ImportError as exc:
+        raise ImportError(f"octax_gym.datasets needs Minari with HDF5 (the datasets extra): "
+                          f"{INSTALL_HINT} ({exc})") from exc
+    return minari
+
+
+def _check_dataset_id(dataset_id) -> None:
+    from minari.dataset.minari_dataset import DATASET_ID_RE
+
+    match = DATASET_ID_RE.fullmatch(dataset_id) if isinstance(dataset_id, str) else None
+    if match is None or match.group("version") is None:
+        raise ValueError(f"dataset_id must look like 'namespace/name-v0' (Minari's format: an optional "
+                         f"namespace/, a name of letters, digits, '-' and '_', and a version -vN), "
+                         f"got {dataset_id!r}")
+
+
+def _check_env_options(options: dict) -> None:
+    unknown = sorted(set(options) - set(GYM_ENV_OPTIONS))
+    if unknown:
+        raise ValueError(f"unknown env option(s) {unknown}; valid: {', '.join(GYM_ENV_OPTIONS)}")
+
+
+def _check_actions(actions, num_envs: int, num_actions: int, game: str) -> np.ndarray:
+    """The policy's output as an int64 array, or an error saying what a batch of actions must be."""
+    values = np.asarray(actions)
+    if values.shape != (num_envs,) or not np.issubdtype(values.dtype, np.integer):
+        raise ValueError(f"the policy must return {num_envs} integer actions, shape ({num_envs},), "
+                         f"got {values.dtype} of shape {values.shape}")
+    if values.size and (values.min() < 0 or values.max() >= num_actions):
+        raise ValueError(f"the policy returned actions out of range ({values.min()}..{values.max()}); "
+                         f"{game}'s actions are 0..{num_actions - 1}")
+    return values.astype(np.int64)
+
+
+def _random_policy(num_envs: int, num_actions: int, seed: int) -> Callable[[np.ndarray], np.ndarray]:
+    generator = np.random.default_rng(seed)
+    return lambda obs: generator.integers(0, num_actions, num_envs)
+
+
+def _noop_policy(num_envs: int, num_actions: int, seed: int) -> Callable[[np.ndarray], np.ndarray]:
+    actions = np.zeros(num_envs, np.int64)
+    return lambda obs: actions
+
+
+# name -> (num_envs, num_actions, seed) -> policy
+POLICIES: dict[str, Callable[[int, int, int], Callable[[np.ndarray], np.ndarray]]] = {
+    "random": _random_policy,  # uniform over the actions, from numpy's generator seeded with `seed`
+    "noop": _noop_policy,  # action 0 (no key) in every lane
+}
+
+
+def _make_policy(policy: Policy, num_envs: int, num_actions: int, seed: int) -> Callable[[np.ndarray], Any]:
+    if callable(policy):
+        return policy
+    if policy is None or policy in POLICIES:
+        return POLICIES[policy or "random"](num_envs, num_actions, seed)
+    raise ValueError(f"unknown policy {policy!r}; valid: None, {', '.join(map(repr, POLICIES))} "
+                     "or a function from a batch of observations to a batch of actions")
+
+
+def _policy_name(policy: Policy) -> str:
+    if callable(policy):
+        return getattr(policy, "__qualname__", type(policy).__name__)
+    return policy or "random"
