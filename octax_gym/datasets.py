@@ -336,6 +336,7 @@ class _Writer:
 
 def _import_minari():
     try:
+        import h5py  # noqa: F401  (Minari's HDF5 storage; its own error would name minari[hdf5])
         import minari
         import minari.data_collector
         import minari.storage
