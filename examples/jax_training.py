@@ -1,0 +1,396 @@
+"""What the pure-JAX PPO and PQN examples share: settings, envs, evaluation, many seeds in one
+program, the log (CSV and learning curve), the training loop and the command line.
+
+An algorithm is a `Trainer`: `init(key) -> runner` and `update(runner) -> (runner, metrics)`, pure
+functions of one agent. `train` runs `config.num_seeds` agents at once: seed i starts from
+`jax.random.key(config.seed + i)` and every function is mapped over seeds with `jax.vmap`, so S
+agents are one compiled program (their env steps and matrix products batched together) and agent i
+learns what a run with `--seed` `config.seed + i` alone learns (tests/examples check it). With one
+seed the functions run as they are, unmapped.
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import dataclasses
+import math
+import time
+from pathlib import Path
+from typing import Any, Callable, NamedTuple, Optional, Sequence
+
+import flax.serialization
+import jax
+import jax.numpy as jnp
+import numpy as np
+from tqdm import tqdm
+
+import octax_core
+from octax_gym.scores import iqm
+
+COMMON_COLUMNS = ("seed", "step", "update", "wall_s", "env_steps_per_s", "eval_mean_return", "eval_std",
+                  "eval_ended_frac", "random_mean_return", "train_episode_return", "train_episodes")
+
+
+@dataclasses.dataclass(frozen=True)
+class RunConfig:
+    """The settings every algorithm has; defaults are the paper's (512 envs x 32 steps, 4 epochs of
+    32 minibatches, Adam 5e-4, evaluation every 131,072 steps on 128 envs)."""
+
+    game: str = "Brix"
+    total_steps: int = 5_000_000  # env steps over all envs, per seed
+    num_envs: int = 512
+    num_steps: int = 32  # rollout length per env and update
+    update_epochs: int = 4
+    num_minibatches: int = 32
+    learning_rate: float = 5e-4
+    anneal_lr: bool = False  # off: the paper names no schedule and its code uses a constant rate
+    gamma: float = 0.99
+    max_grad_norm: float = 0.5
+    seed: int = 0
+    num_seeds: int = 1  # agents trained at once, seeds seed .. seed + num_seeds - 1
+    eval_every: int = 131_072  # env steps (the paper's); 0: only at the start and the end
+    eval_envs: int = 128  # one episode each (the paper's 128 parallel envs)
+    eval_max_steps: Optional[int] = None  # step cap per eval; None: the env's max_episode_steps
+    env_overrides: tuple[tuple[str, Any], ...] = ()  # octax_core.make overrides, e.g. max_episode_steps
+
+    @property
+    def batch_size(self) -> int:
+        return self.num_envs * self.num_steps
+
+    @property
+    def num_updates(self) -> int:
+        return max(1, self.total_steps // self.batch_size)
+
+    @property
+    def seeds(self) -> list[int]:
+        return [self.seed + i for i in range(self.num_seeds)]
+
+    def check(self) -> None:
+        """Raises ValueError for settings no run can use, naming the setting."""
+        if self.batch_size % self.num_minibatches:
+            raise ValueError(f"num_envs * num_steps = {self.batch_size} is not divisible by "
+                             f"num_minibatches = {self.num_minibatches}")
+        if self.num_seeds < 1:
+            raise ValueError(f"num_seeds must be at least 1, got {self.num_seeds}")
+
+
+class Trainer(NamedTuple):
+    """One algorithm for one env: pure functions of one agent, jittable and vmappable."""
+
+    name: str  # "PPO", "PQN": titles and the progress bar
+    network: Any  # the flax module
+    init: Callable  # key -> runner
+    update: Callable  # runner -> (runner, metrics): one rollout and its epochs
+    act: Callable  # (params, key, obs) -> actions: the policy that is evaluated
+    params: Callable  # runner -> the network's params
+    metric_names: tuple[str, ...]  # per-update metrics, averaged between evaluations in the CSV
+    host_metrics: Callable  # update index -> {name: value} for schedules (learning rate, epsilon)
+
+
+# --- envs and evaluation ----------------------------------------------------------------------
+
+def make_envs(config: RunConfig, game=None, rom=None):
+    """The training env (autoreset), the evaluation env (no autoreset) and their params."""
+    game = config.game if game is None else game
+    overrides = dict(config.env_overrides)
+    env, env_params = octax_core.make(game, rom=rom, autoreset=True, **overrides)
+    eval_env, _ = octax_core.make(game, rom=rom, autoreset=False, **overrides)
+    return env, eval_env, env_params
+
+
+def make_evaluate(env: octax_core.Env, env_params: octax_core.EnvParams, num_envs: int,
+                  max_steps: int, act: Callable, jit: bool = True) -> Callable:
+    """`evaluate(act_params, key) -> (returns, ended)`, both (num_envs,), jitted unless `jit=False`.
+
+    Each of `num_envs` envs (made without autoreset) plays one episode with
+    `act(act_params, key, obs) -> actions`, until every episode has ended or `max_steps` steps;
+    `ended` is False for an episode the cap cut short (its return so far is kept).
+    """
+    if env.config.autoreset:
+        raise ValueError("make_evaluate needs an env made with autoreset=False (one episode per env)")
+    v_reset = jax.vmap(env.reset, in_axes=(0, None))
+    v_step = jax.vmap(env.step, in_axes=(0, 0, 0, None))
+
+    def evaluate(act_params, key):
+        key, reset_key = jax.random.split(key)
+        obs, state = v_reset(jax.random.split(reset_key, num_envs), env_params)
+        zeros = jnp.zeros(num_envs, jnp.float32)
+        carry = (jnp.int32(0), key, obs, state, zeros, jnp.zeros(num_envs, jnp.bool_))
+
+        def running(carry):
+            t, _, _, _, _, ended = carry
+            return (t < max_steps) & ~ended.all()
+
+        def body(carry):
+            t, key, obs, state, returns, ended = carry
+            key, act_key, step_key = jax.random.split(key, 3)
+            action = act(act_params, act_key, obs)
+            obs, state, reward, terminated, truncated, _ = v_step(
+                jax.random.split(step_key, num_envs), state, action, env_params)
+            # Ended episodes stand still and pay 0 (no autoreset), so summing is safe.
+            return t + 1, key, obs, state, returns + reward, ended | terminated | truncated
+
+        _, _, _, _, returns, ended = jax.lax.while_loop(running, body, carry)
+        return returns, ended
+
+    return jax.jit(evaluate) if jit else evaluate
+
+
+def random_act(num_actions: int) -> Callable:
+    return lambda _, key, obs: jax.random.randint(key, obs.shape[:1], 0, num_actions)
+
+
+# --- many seeds in one program -----------------------------------------------------------------
+
+def over_seeds(fn: Callable, num_seeds: int, in_axes=0) -> Callable:
+    """`fn` mapped over a leading seed axis: `jax.vmap` for several seeds; for one, `fn` itself on
+    the lone seed's slice (the result gets its seed axis back), so a one-seed run is the plain program."""
+    if num_seeds > 1:
+        return jax.vmap(fn, in_axes=in_axes)
+    axes = in_axes if isinstance(in_axes, tuple) else None
+
+    def lone(*args):
+        sliced = [a if axes is not None and axes[i] is None else jax.tree.map(lambda x: x[0], a)
+                  for i, a in enumerate(args)]
+        return jax.tree.map(lambda x: x[None], fn(*sliced))
+
+    return lone
+
+
+def init_seeds(init: Callable, keys: jax.Array):
+    """`init` run for each seed's key, the results stacked along a leading seed axis.
+
+    One call per seed rather than `jax.vmap(init)`: mapped over keys, initialising either
+    example's network never returned on XLA's CPU backend here (jax 0.10.2; each initializer and
+    layer mapped alone ran, the whole did not, the same call unmapped takes milliseconds; cause
+    not found). Initialising is done once, so nothing is lost, and each seed gets exactly what a
+    run of that seed alone gets.
+    """
+    init = jax.jit(init)
+    return jax.tree.map(lambda *leaves: jnp.stack(leaves), *[init(key) for key in keys])
+
+
+def seed_keys(config: RunConfig) -> tuple[jax.Array, jax.Array, jax.Array]:
+    """Per seed (each (num_seeds,)): the training key, the evaluation key and the random baseline's
+    key, all from `jax.random.key(seed)` as a run of that seed alone makes them."""
+    keys = jnp.stack([jax.random.split(jax.random.key(s), 3) for s in config.seeds])
+    return keys[:, 0], keys[:, 1], keys[:, 2]
+
+
+# --- the run ----------------------------------------------------------------------------------
+
+def train(config: RunConfig, make_train: Callable, out_dir, game=None, rom=None, progress: bool = True) -> dict:
+    """Trains `config.num_seeds` agents of `make_train(config, env, env_params) -> Trainer` at once,
+    evaluating as configured; writes progress.csv, learning_curve.png and the params to `out_dir`.
+
+    `game` (an id or a `GameSpec`) and `rom` default to `config.game` and the ROM store. Returns a
+    summary: paths, training speed (env steps/s over all seeds, compile and evaluation excluded),
+    the random baseline and the last evaluation (means over seeds, and per seed).
+    """
+    config.check()
+    out_dir = Path(out_dir)
+    out_dir.mkdir(parents=True, exist_ok=True)
+    env, eval_env, env_params = make_envs(config, game, rom)
+    trainer = make_train(config, env, env_params)
+    seeds = config.num_seeds
+    eval_steps = config.eval_max_steps or int(env_params.max_episode_steps)
+    evaluate_policy = jax.jit(over_seeds(
+        make_evaluate(eval_env, env_params, config.eval_envs, eval_steps, trainer.act, jit=False), seeds))
+    evaluate_random = jax.jit(over_seeds(
+        make_evaluate(eval_env, env_params, config.eval_envs, eval_steps, random_act(env.num_actions), jit=False),
+        seeds, in_axes=(None, 0)))
+
+    train_keys, eval_keys, random_keys = seed_keys(config)
+    runner = init_seeds(trainer.init, train_keys)
+    compile_start = time.perf_counter()
+    # Compiled ahead of time, so every timed call below runs and none compiles.
+    update = jax.jit(over_seeds(trainer.update, seeds), donate_argnums=0).lower(runner).compile()
+    print(f"compiled the {trainer.name} update in {time.perf_counter() - compile_start:.1f} s "
+          f"({seeds} seed{'s' * (seeds > 1)} x {config.num_envs} envs x {config.num_steps} steps, "
+          f"{config.num_updates} updates)")
+    random_returns, _ = jax.device_get(evaluate_random(None, random_keys))
+    random_means = random_returns.mean(axis=1)
+    print(f"random policy: mean return {random_returns.mean():.2f} +- {random_returns.std():.2f} "
+          f"over {config.eval_envs} episodes x {seeds} seed(s)")
+
+    title = f"{trainer.name} on {env.spec.id} ({config.num_envs} envs x {config.num_steps} steps" + (
+        f", {seeds} seeds)" if seeds > 1 else ")")
+    log = RunLog(out_dir, config.seeds, random_means, title, trainer.metric_names)
+    start = time.perf_counter()
+    bar = tqdm(total=config.num_updates * config.batch_size * seeds, unit="step", unit_scale=True,
+               disable=not progress, desc=f"{trainer.name} {env.spec.id}" + (f" x{seeds}" if seeds > 1 else ""))
+    runner, train_s, rows = _loop(config, trainer, update, runner, evaluate_policy, eval_keys, log, bar, start)
+    bar.close()
+    params = trainer.params(runner)
+    param_paths = []
+    for i, seed in enumerate(config.seeds):
+        path = out_dir / ("params.msgpack" if seeds == 1 else f"params-seed{seed}.msgpack")
+        path.write_bytes(flax.serialization.to_bytes(jax.tree.map(lambda x: x[i], params)))
+        param_paths.append(path)
+    steps_per_s = config.num_updates * config.batch_size * seeds / train_s
+    final = np.array([row["eval_mean_return"] for row in rows])
+    print(f"training speed: {steps_per_s:,.0f} env steps/s over {seeds} seed(s), "
+          f"{train_s / seeds:.1f} s of training per seed (full loop: rollout, targets and epochs; "
+          f"compile and evaluation excluded); wall {time.perf_counter() - start:.0f} s")
+    print(f"final eval: {final.mean():.2f} (per seed: {', '.join(f'{r:.2f}' for r in final)}); "
+          f"random {random_means.mean():.2f}")
+    return {"csv": log.csv_path, "png": log.png_path, "params": param_paths[0], "param_paths": param_paths,
+            "env_steps_per_s": steps_per_s, "train_s": train_s, "train_s_per_seed": train_s / seeds,
+            "random_mean_return": float(random_means.mean()), "final_eval_mean_return": float(final.mean()),
+            "random_mean_returns": random_means.tolist(), "final_eval_mean_returns": final.tolist(),
+            "final_params": params if seeds > 1 else jax.tree.map(lambda x: x[0], params), "rows": log.rows}
+
+
+def _loop(config: RunConfig, trainer: Trainer, update, runner, evaluate_policy, eval_keys, log: "RunLog",
+          bar, start: float):
+    """The updates, with an evaluation of every seed every `eval_every` steps and at both ends.
+
+    Returns the runner, the seconds spent in updates, and the last evaluation's rows (one per seed).
+    """
+    eval_interval = config.num_updates
+    if config.eval_every:
+        eval_interval = max(1, round(config.eval_every / config.batch_size))
+    fold = jax.jit(jax.vmap(jax.random.fold_in, in_axes=(0, None)))
+    train_s, totals = 0.0, {}
+    for i in range(config.num_updates + 1):
+        if i % eval_interval == 0 or i == config.num_updates:
+            returns, ended = jax.device_get(evaluate_policy(trainer.params(runner), fold(eval_keys, i)))
+            rows = log.add(i, i * config.batch_size, time.perf_counter() - start, train_s, returns, ended,
+                           totals, trainer.host_metrics(i))
+            bar.set_postfix(eval=f"{np.mean(returns):.2f}", random=f"{np.mean(log.random_means):.2f}")
+            totals = {}
+        if i == config.num_updates:
+            return runner, train_s, rows
+        t0 = time.perf_counter()
+        runner, metrics = update(runner)
+        metrics = jax.device_get(metrics)  # waits for the update: the timing covers all of it
+        train_s += time.perf_counter() - t0
+        for k, v in metrics.items():
+            totals[k] = totals.get(k, 0.0) + np.asarray(v, np.float64)
+        totals["updates"] = totals.get("updates", 0) + 1
+        bar.update(config.batch_size * config.num_seeds)
+
+
+class RunLog:
+    """Appends one CSV row per seed and evaluation, and redraws the learning curve."""
+
+    def __init__(self, out_dir: Path, seeds: Sequence[int], random_means, title: str, metric_names: Sequence[str]):
+        self.csv_path, self.png_path = out_dir / "progress.csv", out_dir / "learning_curve.png"
+        self.seeds, self.random_means = list(seeds), np.asarray(random_means, np.float64)
+        self.title, self.metric_names, self.rows = title, tuple(metric_names), []
+        self.columns = COMMON_COLUMNS + self.metric_names
+        self._extra_columns: Optional[tuple[str, ...]] = None
+        with open(self.csv_path, "w", newline="") as f:
+            csv.writer(f).writerow(self.columns)
+
+    def add(self, update, step, wall_s, train_s, returns, ended, totals, host_metrics) -> list[dict]:
+        """Rows for one evaluation: `returns` and `ended` are (num_seeds, eval_envs); `totals` holds
+        each metric's (num_seeds,) sum over the updates since the last evaluation."""
+        returns, ended = np.asarray(returns), np.asarray(ended)
+        n = totals.get("updates", 0)
+        rows = []
+        for i, seed in enumerate(self.seeds):
+            episodes = float(totals["finished_episodes"][i]) if n else 0.0
+            row = {"seed": seed, "step": step, "update": update, "wall_s": round(wall_s, 2),
+                   "env_steps_per_s": round(step * len(self.seeds) / train_s, 1) if train_s else math.nan,
+                   "eval_mean_return": float(returns[i].mean()), "eval_std": float(returns[i].std()),
+                   "eval_ended_frac": float(ended[i].mean()), "random_mean_return": float(self.random_means[i]),
+                   "train_episode_return": (float(totals["finished_return_sum"][i]) / episodes
+                                            if episodes else math.nan),
+                   "train_episodes": int(episodes)}
+            for name in self.metric_names:
+                row[name] = float(totals[name][i]) / n if n and name in totals else host_metrics.get(name, math.nan)
+            rows.append(row)
+        self.rows.extend(rows)
+        with open(self.csv_path, "a", newline="") as f:
+            csv.DictWriter(f, self.columns).writerows(rows)
+        self._plot()
+        return rows
+
+    def _plot(self) -> None:
+        import matplotlib
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+
+        fig, ax = plt.subplots(figsize=(7, 4))
+        by_seed = {seed: [r for r in self.rows if r["seed"] == seed] for seed in self.seeds}
+        step = np.array([r["step"] for r in by_seed[self.seeds[0]]])
+        mean = np.array([[r["eval_mean_return"] for r in rows] for rows in by_seed.values()])  # (seeds, evals)
+        if len(self.seeds) == 1:
+            std = np.array([r["eval_std"] for r in by_seed[self.seeds[0]]])
+            ax.plot(step, mean[0], "o-", label="eval, mean")
+            ax.fill_between(step, mean[0] - std, mean[0] + std, alpha=0.2, label="eval, +- 1 std")
+            train_return = np.array([r["train_episode_return"] for r in by_seed[self.seeds[0]]], float)
+            ax.plot(step, train_return, ".--", alpha=0.7, label="training episodes, mean")
+        else:
+            for seed, curve in zip(self.seeds, mean):
+                ax.plot(step, curve, "-", alpha=0.35, linewidth=1)
+            ax.plot(step, [iqm(column) for column in mean.T], "o-", color="C0",
+                    label=f"eval, IQM of {len(self.seeds)} seeds (thin: each seed)")
+        ax.axhline(self.random_means.mean(), color="gray", linestyle=":", label="random policy")
+        ax.set_xlabel("env steps (per seed)")
+        ax.set_ylabel("episode return")
+        ax.set_title(self.title)
+        ax.legend(loc="best", fontsize="small")
+        fig.tight_layout()
+        fig.savefig(self.png_path, dpi=100)
+        plt.close(fig)
+
+
+# --- command line -----------------------------------------------------------------------------
+
+HELP = {
+    "game": "a registered octax game id (python -m octax_gym list)",
+    "total_steps": "env steps over all envs, per seed (rounded down to whole updates)",
+    "num_envs": "parallel training envs per seed",
+    "num_steps": "rollout length per env and update",
+    "update_epochs": "passes over each rollout",
+    "num_minibatches": "Adam steps per epoch (num_envs * num_steps must divide)",
+    "learning_rate": "Adam step size",
+    "anneal_lr": "decay the learning rate linearly to 0 (the paper: constant)",
+    "gamma": "discount",
+    "max_grad_norm": "global gradient-norm clip",
+    "seed": "the first seed: seeds the network, the envs and the evaluations",
+    "num_seeds": "agents trained at once in one program, seeds seed .. seed + num_seeds - 1",
+    "eval_every": "env steps between evaluations; 0: only at the start and the end",
+    "eval_envs": "evaluation episodes (one per env) per seed, played to their end",
+    "eval_max_steps": "step cap per evaluation; None: the env's max_episode_steps",
+}
+ENV_FLAGS = {"max_episode_steps": int, "frames_per_step": int, "repeat_action_probability": float,
+             "noop_max": int}
+
+
+def parse_args(config_type: type, help_text: dict, description: str, runs_dir: str,
+               argv: Optional[Sequence[str]] = None) -> tuple[Any, Path]:
+    """A `config_type` (a `RunConfig` dataclass) and the output folder from the command line:
+    one flag per field, plus the env overrides of ENV_FLAGS and `--out-dir`."""
+    parser = argparse.ArgumentParser(description=description,
+                                     formatter_class=argparse.ArgumentDefaultsHelpFormatter)
+    helps = {**HELP, **help_text}
+    for field in dataclasses.fields(config_type):
+        if field.name == "env_overrides":
+            continue
+        flag = "--" + field.name.replace("_", "-")
+        if field.type in ("bool", bool):
+            parser.add_argument(flag, action=argparse.BooleanOptionalAction, default=field.default,
+                                help=helps[field.name])
+        elif field.name == "eval_max_steps":
+            parser.add_argument(flag, type=int, default=None, help=helps[field.name])
+        else:
+            parser.add_argument(flag, type=type(field.default), default=field.default, help=helps[field.name])
+    for name, kind in ENV_FLAGS.items():
+        parser.add_argument("--" + name.replace("_", "-"), type=kind, default=None,
+                            help="octax_core.make override; None: the game's")
+    parser.add_argument("--out-dir", type=Path, default=None,
+                        help="for progress.csv, learning_curve.png and the params; "
+                             f"None: {runs_dir}/<game>-s<seed>[-n<num_seeds>]")
+    args = vars(parser.parse_args(argv))
+    out_dir = args.pop("out_dir")
+    overrides = tuple((k, args.pop(k)) for k in ENV_FLAGS if args[k] is not None)
+    for k in ENV_FLAGS:
+        args.pop(k, None)
+    config = config_type(**args, env_overrides=overrides)
+    config.check()
+    name = f"{config.game}-s{config.seed}" + (f"-n{config.num_seeds}" if config.num_seeds > 1 else "")
+    return config, out_dir or Path(runs_dir) / name
