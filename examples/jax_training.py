@@ -14,7 +14,9 @@ from __future__ import annotations
 import argparse
 import csv
 import dataclasses
+import json
 import math
+import sys
 import time
 from pathlib import Path
 from typing import Any, Callable, NamedTuple, Optional, Sequence
@@ -182,7 +184,8 @@ def seed_keys(config: RunConfig) -> tuple[jax.Array, jax.Array, jax.Array]:
 
 def train(config: RunConfig, make_train: Callable, out_dir, game=None, rom=None, progress: bool = True) -> dict:
     """Trains `config.num_seeds` agents of `make_train(config, env, env_params) -> Trainer` at once,
-    evaluating as configured; writes progress.csv, learning_curve.png and the params to `out_dir`.
+    evaluating as configured; writes config.json (the algorithm, the env and every setting),
+    progress.csv, learning_curve.png and the params to `out_dir`.
 
     `game` (an id or a `GameSpec`) and `rom` default to `config.game` and the ROM store. Returns a
     summary: paths, training speed (env steps/s over all seeds, compile and evaluation excluded),
@@ -201,6 +204,9 @@ def train(config: RunConfig, make_train: Callable, out_dir, game=None, rom=None,
         make_evaluate(eval_env, env_params, config.eval_envs, eval_steps, random_act(env.num_actions), jit=False),
         seeds, in_axes=(None, 0)))
 
+    (out_dir / "config.json").write_text(json.dumps(
+        {"algorithm": trainer.name, "env_id": env.spec.id, "command": sys.argv,
+         **dataclasses.asdict(config)}, indent=2, default=str) + "\n")
     train_keys, eval_keys, random_keys = seed_keys(config)
     runner = init_seeds(trainer.init, train_keys)
     compile_start = time.perf_counter()
