@@ -20,10 +20,10 @@ from octax_gym.vector import OctaxVectorEnv
 
 ENV_IDS = tuple(register_all())
 
-# The adapters import torch, SB3 or TorchRL: loaded on first use (`octax_gym.make_sb3_vec_env`),
-# never by `import octax_gym`.
+# The adapters import torch, SB3 or TorchRL, the dataset collector Minari: loaded on first use
+# (`octax_gym.make_sb3_vec_env`), never by `import octax_gym`.
 _LAZY = {"make_sb3_vec_env": "octax_gym.sb3", "PPO_KWARGS": "octax_gym.sb3",
-         "make_torchrl_env": "octax_gym.torchrl"}
+         "make_torchrl_env": "octax_gym.torchrl", "collect_dataset": "octax_gym.datasets"}
 
 
 def __getattr__(name: str):

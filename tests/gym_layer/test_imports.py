@@ -42,5 +42,11 @@ def test_the_public_names_stay_where_users_import_them():
     for name in ("OctaxEnv", "OctaxVectorEnv", "InvalidActionError", "make_sb3_vec_env", "make_torchrl_env"):
         assert getattr(octax_gym, name) is not None, name
     assert callable(octax_gym.sb3.make_sb3_vec_env) and callable(octax_gym.torchrl.make_torchrl_env)
+    import octax_gym.datasets
+    import octax_gym.scores
+
+    assert octax_gym.collect_dataset is octax_gym.datasets.collect_dataset
+    for name in ("iqm", "stratified_bootstrap_ci", "aggregate", "normalized_score", "score_table"):
+        assert callable(getattr(octax_gym.scores, name)), name
     assert sorted(octax_core.PLATFORMS) == ["chip8", "schip", "xochip"] and octax_core.Platform is not None
     assert callable(octax_core.emulator.quirks_from_octo)
