@@ -108,7 +108,7 @@ def make_train(config: Config, env: octax_core.Env, env_params: octax_core.EnvPa
             jax.random.split(step_key, n), runner.env_state, action, env_params)
         # Partial-episode bootstrapping: a time limit is not a terminal state, so a truncated
         # episode is credited gamma * V(its last observation). Rare, so the critic runs only then.
-        final_value = jax.lax.cond(truncated.any(),
+        final_value = jax.lax.cond(jax_training.any_over_seeds(truncated, config.num_seeds),
                                    lambda: network.apply(runner.params, info["final_observation"])[1],
                                    lambda: jnp.zeros(n, jnp.float32))
         done = terminated | truncated

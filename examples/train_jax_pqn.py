@@ -121,7 +121,7 @@ def make_train(config: Config, env: octax_core.Env, env_params: octax_core.EnvPa
             jax.random.split(step_key, n), runner.env_state, action, env_params)
         # A time limit is not a terminal state: a truncated episode is credited gamma * max Q of its
         # last observation. Rare, so the network runs on it only then.
-        final_q = jax.lax.cond(truncated.any(),
+        final_q = jax.lax.cond(jax_training.any_over_seeds(truncated, config.num_seeds),
                                lambda: network.apply(runner.params, info["final_observation"]).max(axis=1),
                                lambda: jnp.zeros(n, jnp.float32))
         done = terminated | truncated

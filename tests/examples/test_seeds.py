@@ -67,3 +67,19 @@ def test_seed_keys_are_those_a_lone_run_makes():
         expected = jax.random.split(jax.random.key(seed), 3)
         for keys, j in ((train_keys, 0), (eval_keys, 1), (random_keys, 2)):
             assert np.array_equal(jax.random.key_data(keys[i]), jax.random.key_data(expected[j]))
+
+
+def test_any_over_seeds_is_shared_by_the_mapped_seeds_so_a_cond_stays_a_branch():
+    flags = np.array([[False, False], [False, True], [False, False]])
+    shared = jax_training.over_seeds(lambda f: jax_training.any_over_seeds(f, 3), 3)(flags)
+    assert shared.tolist() == [True, True, True]  # seed 1's truncation is every seed's predicate
+    alone = jax_training.over_seeds(lambda f: jax_training.any_over_seeds(f, 1), 1)(flags[1:2])
+    assert alone.tolist() == [True]
+
+    def step(f):
+        return jax.lax.cond(jax_training.any_over_seeds(f, 3), lambda: f.sum(), lambda: -1)
+
+    jaxpr = str(jax.make_jaxpr(jax_training.over_seeds(step, 3))(flags))
+    assert "cond[" in jaxpr and "select_n" not in jaxpr  # with a per-seed predicate vmap makes it a select
+    per_seed = str(jax.make_jaxpr(jax.vmap(lambda f: jax.lax.cond(f.any(), lambda: f.sum(), lambda: -1)))(flags))
+    assert "select_n" in per_seed
