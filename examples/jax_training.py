@@ -25,6 +25,7 @@ import flax.serialization
 import jax
 import jax.numpy as jnp
 import numpy as np
+import optax
 from tqdm import tqdm
 
 import octax_core
@@ -68,6 +69,13 @@ class RunConfig:
     def seeds(self) -> list[int]:
         return [self.seed + i for i in range(self.num_seeds)]
 
+    def learning_rate_at(self, update: int) -> float:
+        """Adam's rate during update number `update` (from 0): constant, or with `anneal_lr`
+        decaying linearly to 0 over the run, as `make_optimizer`'s schedule does."""
+        if not self.anneal_lr:
+            return self.learning_rate
+        return self.learning_rate * max(0.0, 1.0 - update / self.num_updates)
+
     def check(self) -> None:
         """Raises ValueError for settings no run can use, naming the setting."""
         if self.batch_size % self.num_minibatches:
@@ -88,6 +96,34 @@ class Trainer(NamedTuple):
     params: Callable  # runner -> the network's params
     metric_names: tuple[str, ...]  # per-update metrics, averaged between evaluations in the CSV
     host_metrics: Callable  # update index -> {name: value} for schedules (learning rate, epsilon)
+
+
+# --- the update's shared parts -----------------------------------------------------------------
+
+def make_optimizer(config: RunConfig) -> optax.GradientTransformation:
+    """Adam after global-norm clipping; the rate decays linearly to 0 with `anneal_lr`."""
+    lr = config.learning_rate
+    if config.anneal_lr:
+        lr = optax.linear_schedule(lr, 0.0, config.num_updates * config.update_epochs * config.num_minibatches)
+    return optax.chain(optax.clip_by_global_norm(config.max_grad_norm), optax.adam(lr))
+
+
+def run_epochs(config: RunConfig, sgd_step: Callable, batch, params, opt_state, key):
+    """`config.update_epochs` passes over `batch` (a pytree of (batch_size, ...) arrays), each a
+    shuffle and a `lax.scan` of `sgd_step((params, opt_state), minibatch) -> ((params, opt_state),
+    stats)` over `config.num_minibatches` minibatches. Returns params, opt_state, key and the
+    stats, (update_epochs, num_minibatches) each."""
+    def epoch(carry, _):
+        params, opt_state, key = carry
+        key, perm_key = jax.random.split(key)
+        perm = jax.random.permutation(perm_key, config.batch_size)
+        minibatches = jax.tree.map(
+            lambda x: x[perm].reshape((config.num_minibatches, -1) + x.shape[1:]), batch)
+        (params, opt_state), stats = jax.lax.scan(sgd_step, (params, opt_state), minibatches)
+        return (params, opt_state, key), stats
+
+    (params, opt_state, key), stats = jax.lax.scan(epoch, (params, opt_state, key), None, config.update_epochs)
+    return params, opt_state, key, stats
 
 
 # --- envs and evaluation ----------------------------------------------------------------------

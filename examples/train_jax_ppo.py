@@ -36,7 +36,7 @@ import optax
 import octax_core
 import jax_training
 from jax_networks import ActorCritic, Conv, ConvTorso, conv_valid  # noqa: F401  (the example's network)
-from jax_training import RunConfig, Trainer, make_envs, make_evaluate, random_act  # noqa: F401
+from jax_training import RunConfig, Trainer, make_envs, make_evaluate, make_optimizer, random_act  # noqa: F401
 
 METRICS = ("pg_loss", "v_loss", "entropy", "approx_kl", "clip_frac", "learning_rate")
 CSV_COLUMNS = jax_training.COMMON_COLUMNS + METRICS
@@ -72,14 +72,6 @@ class Transition(NamedTuple):
     reward: jax.Array  # plus gamma * V(final obs) where the episode was truncated
     done: jax.Array  # terminated | truncated: GAE does not look past it
     finished_return: jax.Array  # the episode's return where it ended this step, else 0
-
-
-def make_optimizer(config: Config) -> optax.GradientTransformation:
-    """Adam after global-norm clipping; the rate decays linearly to 0 with `anneal_lr`."""
-    lr = config.learning_rate
-    if config.anneal_lr:
-        lr = optax.linear_schedule(lr, 0.0, config.num_updates * config.update_epochs * config.num_minibatches)
-    return optax.chain(optax.clip_by_global_norm(config.max_grad_norm), optax.adam(lr))
 
 
 def make_train(config: Config, env: octax_core.Env, env_params: octax_core.EnvParams) -> Trainer:
@@ -126,18 +118,8 @@ def make_train(config: Config, env: octax_core.Env, env_params: octax_core.EnvPa
         advantages, targets = _gae(traj, last_value, config.gamma, config.gae_lambda)
         batch = (traj.obs, traj.action, traj.log_prob, traj.value, advantages, targets)
         batch = jax.tree.map(lambda x: x.reshape((config.batch_size,) + x.shape[2:]), batch)
-
-        def epoch(carry, _):
-            params, opt_state, key = carry
-            key, perm_key = jax.random.split(key)
-            perm = jax.random.permutation(perm_key, config.batch_size)
-            minibatches = jax.tree.map(
-                lambda x: x[perm].reshape((config.num_minibatches, -1) + x.shape[1:]), batch)
-            (params, opt_state), stats = jax.lax.scan(sgd_step, (params, opt_state), minibatches)
-            return (params, opt_state, key), stats
-
-        (params, opt_state, key), stats = jax.lax.scan(
-            epoch, (runner.params, runner.opt_state, runner.key), None, config.update_epochs)
+        params, opt_state, key, stats = jax_training.run_epochs(
+            config, sgd_step, batch, runner.params, runner.opt_state, runner.key)
         metrics = {k: v.mean() for k, v in stats.items()}
         metrics["finished_return_sum"] = traj.finished_return.sum()
         metrics["finished_episodes"] = traj.done.sum()
@@ -150,7 +132,7 @@ def make_train(config: Config, env: octax_core.Env, env_params: octax_core.EnvPa
         return (optax.apply_updates(params, updates), opt_state), stats
 
     return Trainer("PPO", network, init, update, policy_act(network), lambda runner: runner.params,
-                   METRICS, lambda i: {"learning_rate": _learning_rate(config, i)})
+                   METRICS, lambda i: {"learning_rate": config.learning_rate_at(i)})
 
 
 def _gae(traj: Transition, last_value: jax.Array, gamma: float, lam: float):
@@ -192,12 +174,6 @@ def _ppo_loss(params, network: ActorCritic, config: Config, minibatch):
 def policy_act(network: ActorCritic) -> Callable:
     """Samples from the policy: the stochastic policy is what is evaluated."""
     return lambda params, key, obs: jax.random.categorical(key, network.apply(params, obs)[0])
-
-
-def _learning_rate(config: Config, update: int) -> float:
-    if not config.anneal_lr:
-        return config.learning_rate
-    return config.learning_rate * max(0.0, 1.0 - update / config.num_updates)
 
 
 # --- the run ----------------------------------------------------------------------------------

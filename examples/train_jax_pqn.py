@@ -34,7 +34,7 @@ import optax
 import octax_core
 import jax_training
 from jax_networks import QNetwork
-from jax_training import RunConfig, Trainer, make_envs, make_evaluate, random_act  # noqa: F401
+from jax_training import RunConfig, Trainer, make_envs, make_evaluate, make_optimizer, random_act  # noqa: F401
 
 METRICS = ("td_loss", "q_mean", "target_mean", "epsilon", "learning_rate")
 CSV_COLUMNS = jax_training.COMMON_COLUMNS + METRICS
@@ -76,14 +76,6 @@ class Transition(NamedTuple):
     reward: jax.Array  # plus gamma * max_a Q(final obs, a) where the episode was truncated
     done: jax.Array  # terminated | truncated: the returns do not look past it
     finished_return: jax.Array  # the episode's return where it ended this step, else 0
-
-
-def make_optimizer(config: Config) -> optax.GradientTransformation:
-    """Adam after global-norm clipping; the rate decays linearly to 0 with `anneal_lr`."""
-    lr = config.learning_rate
-    if config.anneal_lr:
-        lr = optax.linear_schedule(lr, 0.0, config.num_updates * config.update_epochs * config.num_minibatches)
-    return optax.chain(optax.clip_by_global_norm(config.max_grad_norm), optax.adam(lr))
 
 
 def epsilon_greedy(q_values: jax.Array, key: jax.Array, epsilon) -> jax.Array:
@@ -140,18 +132,8 @@ def make_train(config: Config, env: octax_core.Env, env_params: octax_core.EnvPa
         targets = q_lambda_targets(traj, last_q, config.gamma, config.q_lambda)
         batch = (traj.obs, traj.action, targets)
         batch = jax.tree.map(lambda x: x.reshape((config.batch_size,) + x.shape[2:]), batch)
-
-        def epoch(carry, _):
-            params, opt_state, key = carry
-            key, perm_key = jax.random.split(key)
-            perm = jax.random.permutation(perm_key, config.batch_size)
-            minibatches = jax.tree.map(
-                lambda x: x[perm].reshape((config.num_minibatches, -1) + x.shape[1:]), batch)
-            (params, opt_state), stats = jax.lax.scan(sgd_step, (params, opt_state), minibatches)
-            return (params, opt_state, key), stats
-
-        (params, opt_state, key), stats = jax.lax.scan(
-            epoch, (runner.params, runner.opt_state, runner.key), None, config.update_epochs)
+        params, opt_state, key, stats = jax_training.run_epochs(
+            config, sgd_step, batch, runner.params, runner.opt_state, runner.key)
         metrics = {k: v.mean() for k, v in stats.items()}
         metrics["target_mean"] = targets.mean()
         metrics["epsilon"] = epsilon
@@ -170,7 +152,7 @@ def make_train(config: Config, env: octax_core.Env, env_params: octax_core.EnvPa
         return epsilon_greedy(network.apply(params, obs), key, config.eval_epsilon)
 
     return Trainer("PQN", network, init, update, act, lambda runner: runner.params, METRICS,
-                   lambda i: {"learning_rate": _learning_rate(config, i), "epsilon": float(config.epsilon(i))})
+                   lambda i: {"learning_rate": config.learning_rate_at(i), "epsilon": float(config.epsilon(i))})
 
 
 def q_lambda_targets(traj: Transition, last_q: jax.Array, gamma: float, lam: float) -> jax.Array:
@@ -199,12 +181,6 @@ def _td_loss(params, network: QNetwork, minibatch):
     q_taken = jnp.take_along_axis(q_values, action[:, None], 1)[:, 0]
     loss = 0.5 * jnp.square(q_taken - jax.lax.stop_gradient(target)).mean()
     return loss, {"td_loss": loss, "q_mean": q_taken.mean()}
-
-
-def _learning_rate(config: Config, update: int) -> float:
-    if not config.anneal_lr:
-        return config.learning_rate
-    return config.learning_rate * max(0.0, 1.0 - update / config.num_updates)
 
 
 # --- the run ----------------------------------------------------------------------------------
