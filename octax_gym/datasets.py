@@ -5,8 +5,8 @@
     dataset = result.dataset                       # the same as minari.load_dataset("octax/Brix-random-v0")
 
 Minari's own `DataCollector` wraps one env and steps it alone. Here all `num_envs` lanes step in
-one jitted call, the compiled program behind `OctaxEnv` and `OctaxVectorEnv`
-(`octax_gym.program`), and each lane's episode is gathered on the host until it ends. A lane
+one jitted call, the compiled env step behind `OctaxEnv` and `OctaxVectorEnv`
+(`octax_gym.compiled_step`), and each lane's episode is gathered on the host until it ends. A lane
 whose episode ends is reset in the same call with the next unused seed, so every episode, not
 just each lane's first, starts the way `OctaxEnv.reset(seed=s)` starts: from the key chain of
 its own seed s. `dataset.recover_environment()`, reset with an episode's seed (`episode_seed`)
@@ -36,8 +36,8 @@ from gymnasium.vector import AutoresetMode
 from tqdm import tqdm
 
 from octax_core.validate import check_int
-from octax_gym import action_check, program
-from octax_gym.program import GYM_ENV_OPTIONS, MAX_SEED
+from octax_gym import action_check, compiled_step
+from octax_gym.compiled_step import GYM_ENV_OPTIONS, MAX_SEED
 from octax_gym.video import resolve_env_id
 
 # A policy maps the batched observation, uint8 (num_envs, frames_per_step, H, W), to one action
@@ -96,7 +96,7 @@ def collect_dataset(env_id: str, dataset_id: str, num_steps: int, *, num_envs: i
             defaults to one naming the game, policy, lanes and seed).
         flush_steps: finished episodes are written in groups of at least this many steps, which
             bounds the memory they hold.
-        **env_options: the env's options (`octax_gym.program.GYM_ENV_OPTIONS`: max_episode_steps,
+        **env_options: the env's options (`octax_gym.compiled_step.GYM_ENV_OPTIONS`: max_episode_steps,
             frames_per_step, noop_max, repeat_action_probability, ...); they are stored in the
             dataset's env spec, so `recover_environment()` builds the same env.
 
@@ -230,9 +230,9 @@ def _collect(lanes: "_Lanes", act: Callable[[np.ndarray], Any], num_steps: int, 
 
 
 class _Lanes:
-    """`num_envs` lanes of one game driven by the compiled program behind `OctaxEnv` and
-    `OctaxVectorEnv` (`octax_gym.program`), with the envs' key derivation, in one jitted call
-    per step: the batched step, then a reset of each lane whose episode just ended.
+    """`num_envs` lanes of one game driven by the compiled env step behind `OctaxEnv` and
+    `OctaxVectorEnv` (`octax_gym.compiled_step`), with the envs' key derivation, in one jitted
+    call per step: the batched step, then a reset of each lane whose episode just ended.
 
     Seeds flow as in the envs: a lane reset with seed s starts its key chain at
     `jax.random.key(s)` and resets with the key's first split, exactly as `OctaxEnv.reset(seed=s)`
@@ -241,17 +241,17 @@ class _Lanes:
     """
 
     def __init__(self, game: str, num_envs: int, env_options: dict):
-        self.program, self.params = program.build(game, None, env_options)
-        core = self.program.env
+        self.compiled, self.params = compiled_step.build(game, None, env_options)
+        core = self.compiled.env
         self.num_envs, self.game, self.num_actions = num_envs, core.spec.id, core.num_actions
         self.observation_space = spaces.Box(0, core.observation_high, core.observation_shape, np.uint8)
-        self._step = _step_and_reset(self.program)
+        self._step = _step_and_reset(self.compiled)
         self._keys = self._state = None
 
     def start(self, seed: int) -> tuple[np.ndarray, dict]:
         """Resets lane i with seed + i; returns the observations and infos (numpy)."""
-        keys = program.keys_from_seeds(program.seeds_for(seed, self.num_envs))
-        self._keys, obs, self._state, info = self.program.reset(keys, None, None, None, self.params)
+        keys = compiled_step.keys_from_seeds(compiled_step.seeds_for(seed, self.num_envs))
+        self._keys, obs, self._state, info = self.compiled.reset(keys, None, None, None, self.params)
         return jax.device_get((obs, _unmasked(info)))
 
     def step(self, actions: np.ndarray, next_seed: int):
@@ -264,15 +264,15 @@ class _Lanes:
 
 
 @functools.lru_cache(maxsize=16)
-def _step_and_reset(compiled: program.Program):
-    """The lanes' jitted step for one game and config (cached, like the program: one compile per
+def _step_and_reset(compiled: compiled_step.CompiledStep):
+    """The lanes' jitted step for one game and config (cached, like the compiled step: one compile per
     batch size)."""
     def step_and_reset(keys, state, actions, next_seed, params):
         keys, last, state, reward, terminated, truncated, info, _ = compiled.step[AutoresetMode.DISABLED](
             keys, state, actions, jnp.asarray(action_check.NO_REPORT, jnp.int32), params)
         ended = terminated | truncated
         seeds = next_seed + jnp.cumsum(ended, dtype=jnp.uint32) - 1  # lane order
-        keys = program.select_keys(ended, program.keys_from_seeds(seeds), keys)
+        keys = compiled_step.select_keys(ended, compiled_step.keys_from_seeds(seeds), keys)
         keys, obs, state, first_info = compiled.reset(keys, state, last, ended, params)
         return keys, state, (last, reward, terminated, truncated, _unmasked(info), obs, _unmasked(first_info),
                              seeds)

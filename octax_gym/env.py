@@ -1,6 +1,6 @@
 """`OctaxEnv`: one CHIP-8 game as a `gymnasium.Env`, the env behind `gymnasium.make`.
 
-It runs the same compiled program as `OctaxVectorEnv` with a batch of one, so a single env
+It runs the same compiled env step as `OctaxVectorEnv` with a batch of one, so a single env
 seeded s and row i of a vector env seeded s - i play the same game step for step. For many envs
 use `gymnasium.make_vec`: one batched call is far faster than many single envs.
 """

@@ -28,7 +28,7 @@ from tensordict import TensorDict, TensorDictBase
 from torchrl.data import Bounded, Categorical, Composite, Unbounded
 from torchrl.envs import EnvBase
 
-from octax_gym.program import seeds_for
+from octax_gym.compiled_step import seeds_for
 from octax_gym.vector import OctaxVectorEnv
 
 # Keywords this adapter fixes itself: the core must not autoreset and must hand back torch tensors.

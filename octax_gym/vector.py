@@ -21,11 +21,11 @@ import numpy as np
 from gymnasium import spaces
 from gymnasium.vector import AutoresetMode
 
-from octax_gym import action_check, backends, program, render
+from octax_gym import action_check, backends, compiled_step, render
 from octax_core.emulator.state import screen_values
 from octax_core.env.config import check_option_names
 from octax_core.validate import check_int
-from octax_gym.program import GYM_ENV_OPTIONS, build, keys_from_seeds, seeds_for
+from octax_gym.compiled_step import GYM_ENV_OPTIONS, build, keys_from_seeds, seeds_for
 
 FRAMES_PER_SECOND = 60  # the CHIP-8 timer rate; a step lasts frames_per_step of these frames
 
@@ -96,13 +96,13 @@ class OctaxVectorEnv(gymnasium.vector.VectorEnv):
         self.render_scale = render.check_render_scale(render_scale)
         if palette is not None:
             self.palette = render.resolve_palette(palette)  # a bad one raises before the build
-        self._program, params = build(game, rom, env_options)
-        self.core_env = self._program.env
+        self._compiled, params = build(game, rom, env_options)
+        self.core_env = self._compiled.env
         self.game_spec = self.core_env.spec
         if palette is None:
             self.palette = render.resolve_palette(self.game_spec.palette or render.DEFAULT_PALETTE)
         self.params = jax.device_put(params, self.device)
-        self._step_fn = self._program.step[self.autoreset_mode]
+        self._step_fn = self._compiled.step[self.autoreset_mode]
         self._action_check = action_check.DeferredCheck(self.game_spec.id, self.core_env.num_actions, self.device)
 
         config = self.core_env.config
@@ -136,11 +136,11 @@ class OctaxVectorEnv(gymnasium.vector.VectorEnv):
             if self._keys is None or mask is None:
                 self._keys = keys
             else:
-                self._keys = program.select_keys(jax.numpy.asarray(mask), keys, self._keys)
+                self._keys = compiled_step.select_keys(jax.numpy.asarray(mask), keys, self._keys)
         if self._state is None or mask is None:
-            self._keys, self._obs, self._state, info = self._program.reset(self._keys, None, None, None, self.params)
+            self._keys, self._obs, self._state, info = self._compiled.reset(self._keys, None, None, None, self.params)
         else:
-            self._keys, self._obs, self._state, info = self._program.reset(
+            self._keys, self._obs, self._state, info = self._compiled.reset(
                 self._keys, self._state, self._obs, jax.device_put(mask, self.device), self.params)
         return backends.to_backend(self._obs, self.backend), backends.to_backend(info, self.backend)
 

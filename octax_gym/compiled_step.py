@@ -1,4 +1,4 @@
-"""The compiled programs behind the Gymnasium envs: one jitted call per reset and per step.
+"""The compiled env step behind the Gymnasium envs: one jitted call per reset and per step.
 
 Both envs (`OctaxEnv`, `OctaxVectorEnv`) run the functional core (`octax_core.make`, its own
 autoreset off) through this, and differ only in batching and host conversions. What is here is
@@ -14,7 +14,7 @@ what Gymnasium adds to the core:
 * the info dict gets Gymnasium's `_name` masks, and SAME_STEP its batched `final_obs`/`final_info`;
 * device actions get their range checked in the step (`octax_gym.action_check`).
 
-Programs are cached per (game, config, ROM), so every env of one game shares its compilations.
+`CompiledStep`s are cached per (game, config, ROM), so every env of one game shares its compilations.
 """
 
 from __future__ import annotations
@@ -42,7 +42,7 @@ def advance(key: jax.Array) -> tuple[jax.Array, jax.Array, jax.Array]:
     return next_key, step_key, reset_key
 
 
-class Program:
+class CompiledStep:
     """The jitted reset and step of one game and config, for any batch size."""
 
     def __init__(self, env: Env):
@@ -102,16 +102,16 @@ def select_keys(mask, on_true, on_false):
 
 
 @functools.lru_cache(maxsize=64)
-def _program(spec: GameSpec, config: EnvConfig, rom: Optional[str]) -> Program:
-    return Program(Env(spec, config, rom))
+def _compiled_step(spec: GameSpec, config: EnvConfig, rom: Optional[str]) -> CompiledStep:
+    return CompiledStep(Env(spec, config, rom))
 
 
-def build(game: Any, rom, options: dict[str, Any]) -> tuple[Program, EnvParams]:
-    """The cached program and checked params for a game id or `GameSpec` and `GYM_ENV_OPTIONS`
+def build(game: Any, rom, options: dict[str, Any]) -> tuple[CompiledStep, EnvParams]:
+    """The cached compiled step and checked params for a game id or `GameSpec` and `GYM_ENV_OPTIONS`
     keywords (None means the game's default)."""
     spec = game if isinstance(game, GameSpec) else octax_core.get_spec(_check_game(game))
     config, params = octax_core.make_config(spec, autoreset=False, **options)  # checks every value
-    return _program(spec, config, None if rom is None else str(rom)), params
+    return _compiled_step(spec, config, None if rom is None else str(rom)), params
 
 
 def _check_game(game) -> str:
