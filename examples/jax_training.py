@@ -1,5 +1,7 @@
-"""What the pure-JAX PPO and PQN examples share: settings, envs, evaluation, many seeds in one
-program, the log (CSV and learning curve), the training loop and the command line.
+"""What the pure-JAX PPO and PQN examples share around their updates: settings, envs, evaluation,
+many seeds in one program, the log (CSV and learning curve), the training loop and the command
+line (`main`). What their updates share (the runner, the rollout, the minibatch epochs) is
+examples/jax_update.py.
 
 An algorithm is a `Trainer`: `init(key) -> runner` and `update(runner) -> (runner, metrics)`, pure
 functions of one agent. `train` runs `config.num_seeds` agents at once: seed i starts from
@@ -25,7 +27,6 @@ import flax.serialization
 import jax
 import jax.numpy as jnp
 import numpy as np
-import optax
 from tqdm import tqdm
 
 import octax_core
@@ -71,7 +72,7 @@ class RunConfig:
 
     def learning_rate_at(self, update: int) -> float:
         """Adam's rate during update number `update` (from 0): constant, or with `anneal_lr`
-        decaying linearly to 0 over the run, as `make_optimizer`'s schedule does."""
+        decaying linearly to 0 over the run, as `jax_update.make_optimizer`'s schedule does."""
         if not self.anneal_lr:
             return self.learning_rate
         return self.learning_rate * max(0.0, 1.0 - update / self.num_updates)
@@ -96,34 +97,6 @@ class Trainer(NamedTuple):
     params: Callable  # runner -> the network's params
     metric_names: tuple[str, ...]  # per-update metrics, averaged between evaluations in the CSV
     host_metrics: Callable  # update index -> {name: value} for schedules (learning rate, epsilon)
-
-
-# --- the update's shared parts -----------------------------------------------------------------
-
-def make_optimizer(config: RunConfig) -> optax.GradientTransformation:
-    """Adam after global-norm clipping; the rate decays linearly to 0 with `anneal_lr`."""
-    lr = config.learning_rate
-    if config.anneal_lr:
-        lr = optax.linear_schedule(lr, 0.0, config.num_updates * config.update_epochs * config.num_minibatches)
-    return optax.chain(optax.clip_by_global_norm(config.max_grad_norm), optax.adam(lr))
-
-
-def run_epochs(config: RunConfig, sgd_step: Callable, batch, params, opt_state, key):
-    """`config.update_epochs` passes over `batch` (a pytree of (batch_size, ...) arrays), each a
-    shuffle and a `lax.scan` of `sgd_step((params, opt_state), minibatch) -> ((params, opt_state),
-    stats)` over `config.num_minibatches` minibatches. Returns params, opt_state, key and the
-    stats, (update_epochs, num_minibatches) each."""
-    def epoch(carry, _):
-        params, opt_state, key = carry
-        key, perm_key = jax.random.split(key)
-        perm = jax.random.permutation(perm_key, config.batch_size)
-        minibatches = jax.tree.map(
-            lambda x: x[perm].reshape((config.num_minibatches, -1) + x.shape[1:]), batch)
-        (params, opt_state), stats = jax.lax.scan(sgd_step, (params, opt_state), minibatches)
-        return (params, opt_state, key), stats
-
-    (params, opt_state, key), stats = jax.lax.scan(epoch, (params, opt_state, key), None, config.update_epochs)
-    return params, opt_state, key, stats
 
 
 # --- envs and evaluation ----------------------------------------------------------------------
@@ -454,3 +427,15 @@ def parse_args(config_type: type, help_text: dict, description: str, runs_dir: s
     config.check()
     name = f"{config.game}-s{config.seed}" + (f"-n{config.num_seeds}" if config.num_seeds > 1 else "")
     return config, out_dir or Path(runs_dir) / name
+
+
+def main(name: str, config_type: type, make_train: Callable, help_text: dict, doc: str, runs_dir: str,
+         argv: Optional[Sequence[str]] = None) -> dict:
+    """An example's command line: parses `argv` into a `config_type` (flags described by
+    `help_text` and the first paragraph of the example's `doc`), trains `make_train`'s algorithm
+    `name` with `train` and returns its summary."""
+    config, out_dir = parse_args(config_type, help_text, doc.split("\n\n")[0], runs_dir, argv)
+    print(f"{name} on {config.game}: {config}")
+    summary = train(config, make_train, out_dir)
+    print(f"wrote {summary['csv']} and {summary['png']}")
+    return summary

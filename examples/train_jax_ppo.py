@@ -12,7 +12,9 @@ rate is constant (`--anneal-lr` decays it linearly to 0): the paper does not men
 and its code (Rejax-based) passes a constant rate to Adam.
 
 One update is `lax.scan` over `num_steps` vmapped env steps (same-step autoreset), GAE, then
-`update_epochs` x `num_minibatches` Adam steps, all in one compiled call. Every `--eval-every`
+`update_epochs` x `num_minibatches` Adam steps, all in one compiled call. The rollout and the
+epochs are examples/jax_update.py's, shared with the PQN example; this file holds what is PPO's:
+sampling from the actor, GAE and the clipped loss. Every `--eval-every`
 env steps the current policy plays `--eval-envs` separate episodes to the end (actions sampled:
 the policy is stochastic, as in the paper's evaluation), and a uniform-random policy is measured
 the same way once at the start. `--num-seeds S` trains S independent agents (seeds seed ..
@@ -26,17 +28,16 @@ from __future__ import annotations
 
 import dataclasses
 import sys
-from pathlib import Path
-from typing import Any, Callable, NamedTuple, Optional, Sequence
+from typing import Callable, NamedTuple, Optional, Sequence
 
 import jax
 import jax.numpy as jnp
-import optax
 
 import octax_core
 import jax_training
+import jax_update
 from jax_networks import ActorCritic, Conv, ConvTorso, conv_valid  # noqa: F401  (the example's network)
-from jax_training import RunConfig, Trainer, make_envs, make_evaluate, make_optimizer, random_act  # noqa: F401
+from jax_training import RunConfig, Trainer, make_envs, make_evaluate, random_act  # noqa: F401
 
 METRICS = ("pg_loss", "v_loss", "entropy", "approx_kl", "clip_frac", "learning_rate")
 CSV_COLUMNS = jax_training.COMMON_COLUMNS + METRICS
@@ -55,97 +56,60 @@ class Config(RunConfig):
 
 # --- training ---------------------------------------------------------------------------------
 
-class RunnerState(NamedTuple):
-    params: Any
-    opt_state: Any
-    env_state: Any  # batched octax_core.EnvState
-    obs: jax.Array  # (num_envs, F, 32, 64) uint8
-    episode_return: jax.Array  # (num_envs,) float32, return so far of each running episode
-    key: jax.Array
+class OldPolicy(NamedTuple):
+    """What the rollout's policy said at each step, kept for the ratio and the value clip."""
 
-
-class Transition(NamedTuple):
-    obs: jax.Array
-    action: jax.Array
-    log_prob: jax.Array
-    value: jax.Array
-    reward: jax.Array  # plus gamma * V(final obs) where the episode was truncated
-    done: jax.Array  # terminated | truncated: GAE does not look past it
-    finished_return: jax.Array  # the episode's return where it ended this step, else 0
+    log_prob: jax.Array  # (num_envs,) float32, of the action taken
+    value: jax.Array  # (num_envs,) float32, the critic's
 
 
 def make_train(config: Config, env: octax_core.Env, env_params: octax_core.EnvParams) -> Trainer:
     """PPO for `env` (made with `autoreset=True`): a `Trainer` of one agent; jit `update` yourself
     (`jax_training.train` maps it over seeds and compiles it)."""
-    if not env.config.autoreset:
-        raise ValueError("make_train needs an env made with autoreset=True (it scans over episode ends)")
     config.check()
-    network, optimizer = ActorCritic(env.num_actions), make_optimizer(config)
-    v_reset = jax.vmap(env.reset, in_axes=(0, None))
-    v_step = jax.vmap(env.step, in_axes=(0, 0, 0, None))
-    n = config.num_envs
+    network, optimizer = ActorCritic(env.num_actions), jax_update.make_optimizer(config)
 
-    def init(key: jax.Array) -> RunnerState:
-        key, net_key, env_key = jax.random.split(key, 3)
-        obs, env_state = v_reset(jax.random.split(env_key, n), env_params)
-        params = network.init(net_key, obs[:1])
-        return RunnerState(params, optimizer.init(params), env_state, obs, jnp.zeros(n, jnp.float32), key)
-
-    def env_step(runner: RunnerState, _):
-        key, action_key, step_key = jax.random.split(runner.key, 3)
-        logits, value = network.apply(runner.params, runner.obs)
-        action = jax.random.categorical(action_key, logits)
+    def act(params, key, obs, _):
+        logits, value = network.apply(params, obs)
+        action = jax.random.categorical(key, logits)
         log_prob = jnp.take_along_axis(jax.nn.log_softmax(logits), action[:, None], 1)[:, 0]
-        obs, env_state, reward, terminated, truncated, info = v_step(
-            jax.random.split(step_key, n), runner.env_state, action, env_params)
-        # Partial-episode bootstrapping: a time limit is not a terminal state, so a truncated
-        # episode is credited gamma * V(its last observation). Rare, so the critic runs only then.
-        final_value = jax.lax.cond(jax_training.any_over_seeds(truncated, config.num_seeds),
-                                   lambda: network.apply(runner.params, info["final_observation"])[1],
-                                   lambda: jnp.zeros(n, jnp.float32))
-        done = terminated | truncated
-        episode_return = runner.episode_return + reward
-        transition = Transition(runner.obs, action, log_prob, value,
-                                reward + config.gamma * jnp.where(truncated, final_value, 0.0),
-                                done, jnp.where(done, episode_return, 0.0))
-        runner = runner._replace(env_state=env_state, obs=obs, key=key,
-                                 episode_return=jnp.where(done, 0.0, episode_return))
-        return runner, transition
+        return action, OldPolicy(log_prob, value)
 
-    def update(runner: RunnerState):
-        runner, traj = jax.lax.scan(env_step, runner, None, config.num_steps)
-        last_value = network.apply(runner.params, runner.obs)[1]
-        advantages, targets = _gae(traj, last_value, config.gamma, config.gae_lambda)
-        batch = (traj.obs, traj.action, traj.log_prob, traj.value, advantages, targets)
-        batch = jax.tree.map(lambda x: x.reshape((config.batch_size,) + x.shape[2:]), batch)
-        params, opt_state, key, stats = jax_training.run_epochs(
-            config, sgd_step, batch, runner.params, runner.opt_state, runner.key)
-        metrics = {k: v.mean() for k, v in stats.items()}
-        metrics["finished_return_sum"] = traj.finished_return.sum()
-        metrics["finished_episodes"] = traj.done.sum()
-        return runner._replace(params=params, opt_state=opt_state, key=key), metrics
+    def critic(params, obs):
+        return network.apply(params, obs)[1]
 
-    def sgd_step(carry, minibatch):
-        params, opt_state = carry
-        grads, stats = jax.grad(_ppo_loss, has_aux=True)(params, network, config, minibatch)
-        updates, opt_state = optimizer.update(grads, opt_state, params)
-        return (optax.apply_updates(params, updates), opt_state), stats
+    rollout = jax_update.make_rollout(config, env, env_params, act, critic)
+    learn = jax_update.make_learn(config, optimizer, lambda params, minibatch: _ppo_loss(
+        params, network, config, minibatch))
 
-    return Trainer("PPO", network, init, update, policy_act(network), lambda runner: runner.params,
-                   METRICS, lambda i: {"learning_rate": config.learning_rate_at(i)})
+    def update(runner: jax_update.RunnerState):
+        runner, traj = rollout(runner)
+        old = traj.policy_out
+        advantages, targets = _gae(traj.reward, traj.done, old.value, critic(runner.params, runner.obs),
+                                   config.gamma, config.gae_lambda)
+        runner, metrics = learn(runner, (traj.obs, traj.action, old.log_prob, old.value, advantages, targets))
+        return runner, {**metrics, **jax_update.episode_totals(traj)}
+
+    return Trainer("PPO", network, jax_update.make_init(config, env, env_params, network, optimizer), update,
+                   policy_act(network), lambda runner: runner.params, METRICS,
+                   lambda i: {"learning_rate": config.learning_rate_at(i)})
 
 
-def _gae(traj: Transition, last_value: jax.Array, gamma: float, lam: float):
-    """Generalized advantage estimates and value targets, both (num_steps, num_envs)."""
-    def backward(carry, t):
+def _gae(reward: jax.Array, done: jax.Array, value: jax.Array, last_value: jax.Array, gamma: float,
+         lam: float):
+    """Generalized advantage estimates and value targets, both (num_steps, num_envs) as the inputs;
+    `last_value` (num_envs,) is the critic's after the last step."""
+    def backward(carry, step):
         advantage, next_value = carry
-        not_done = 1.0 - t.done.astype(jnp.float32)
-        delta = t.reward + gamma * next_value * not_done - t.value
+        reward, done, value = step
+        not_done = 1.0 - done.astype(jnp.float32)
+        delta = reward + gamma * next_value * not_done - value
         advantage = delta + gamma * lam * not_done * advantage
-        return (advantage, t.value), advantage
+        return (advantage, value), advantage
 
-    _, advantages = jax.lax.scan(backward, (jnp.zeros_like(last_value), last_value), traj, reverse=True)
-    return advantages, advantages + traj.value
+    _, advantages = jax.lax.scan(backward, (jnp.zeros_like(last_value), last_value), (reward, done, value),
+                                 reverse=True)
+    return advantages, advantages + value
 
 
 def _ppo_loss(params, network: ActorCritic, config: Config, minibatch):
@@ -193,16 +157,9 @@ HELP = {
 }
 
 
-def parse_args(argv: Optional[Sequence[str]] = None) -> tuple[Config, Path]:
-    return jax_training.parse_args(Config, HELP, __doc__.split("\n\n")[0], "runs/jax_ppo", argv)
-
-
 def main(argv: Optional[Sequence[str]] = None) -> dict:
-    config, out_dir = parse_args(argv)
-    print(f"PPO on {config.game}: {config}")
-    summary = train(config, out_dir)
-    print(f"wrote {summary['csv']} and {summary['png']}")
-    return summary
+    """The command line (`jax_training.main`): flags, training, and the summary returned."""
+    return jax_training.main("PPO", Config, make_train, HELP, __doc__, "runs/jax_ppo", argv)
 
 
 if __name__ == "__main__":

@@ -17,24 +17,25 @@ setting: the paper gives no value), gamma 0.99, constant learning rate. Evaluati
 epsilon-greedy policy with epsilon 0.005 (the paper's code evaluates with it).
 
 Same command line, progress bar, CSV and learning curve as the PPO example (examples/jax_training.py),
-`--num-seeds S` included. See docs/training.md.
+`--num-seeds S` included, and the same rollout and minibatch epochs (examples/jax_update.py); this
+file holds what is PQN's: epsilon-greedy acting, the Q(lambda) targets and the TD loss. See
+docs/training.md.
 """
 
 from __future__ import annotations
 
 import dataclasses
 import sys
-from pathlib import Path
-from typing import Any, Callable, NamedTuple, Optional, Sequence
+from typing import Any, Optional, Sequence
 
 import jax
 import jax.numpy as jnp
-import optax
 
 import octax_core
 import jax_training
+import jax_update
 from jax_networks import QNetwork
-from jax_training import RunConfig, Trainer, make_envs, make_evaluate, make_optimizer, random_act  # noqa: F401
+from jax_training import RunConfig, Trainer, make_envs, make_evaluate, random_act  # noqa: F401
 
 METRICS = ("td_loss", "q_mean", "target_mean", "epsilon", "learning_rate")
 CSV_COLUMNS = jax_training.COMMON_COLUMNS + METRICS
@@ -59,25 +60,6 @@ class Config(RunConfig):
         return self.epsilon_start + (self.epsilon_finish - self.epsilon_start) * progress
 
 
-class RunnerState(NamedTuple):
-    params: Any
-    opt_state: Any
-    env_state: Any  # batched octax_core.EnvState
-    obs: jax.Array  # (num_envs, F, 32, 64) uint8
-    episode_return: jax.Array  # (num_envs,) float32, return so far of each running episode
-    key: jax.Array
-    updates: jax.Array  # int32: updates done, for the epsilon schedule
-
-
-class Transition(NamedTuple):
-    obs: jax.Array
-    action: jax.Array
-    q_max: jax.Array  # max_a Q(obs, a) under the rollout's params: the bootstrap of the step before
-    reward: jax.Array  # plus gamma * max_a Q(final obs, a) where the episode was truncated
-    done: jax.Array  # terminated | truncated: the returns do not look past it
-    finished_return: jax.Array  # the episode's return where it ended this step, else 0
-
-
 def epsilon_greedy(q_values: jax.Array, key: jax.Array, epsilon) -> jax.Array:
     """argmax Q, or with probability epsilon a uniformly random action, per row."""
     explore_key, action_key = jax.random.split(key)
@@ -89,89 +71,55 @@ def epsilon_greedy(q_values: jax.Array, key: jax.Array, epsilon) -> jax.Array:
 def make_train(config: Config, env: octax_core.Env, env_params: octax_core.EnvParams) -> Trainer:
     """PQN for `env` (made with `autoreset=True`): a `Trainer` of one agent; jit `update` yourself
     (`jax_training.train` maps it over seeds and compiles it)."""
-    if not env.config.autoreset:
-        raise ValueError("make_train needs an env made with autoreset=True (it scans over episode ends)")
     config.check()
-    network, optimizer = QNetwork(env.num_actions), make_optimizer(config)
-    v_reset = jax.vmap(env.reset, in_axes=(0, None))
-    v_step = jax.vmap(env.step, in_axes=(0, 0, 0, None))
-    n = config.num_envs
+    network, optimizer = QNetwork(env.num_actions), jax_update.make_optimizer(config)
 
-    def init(key: jax.Array) -> RunnerState:
-        key, net_key, env_key = jax.random.split(key, 3)
-        obs, env_state = v_reset(jax.random.split(env_key, n), env_params)
-        params = network.init(net_key, obs[:1])
-        return RunnerState(params, optimizer.init(params), env_state, obs, jnp.zeros(n, jnp.float32), key,
-                           jnp.int32(0))
+    def explore(params, key, obs, epsilon):
+        q_values = network.apply(params, obs)
+        return epsilon_greedy(q_values, key, epsilon), q_values.max(axis=1)
 
-    def env_step(carry, _):
-        runner, epsilon = carry
-        key, action_key, step_key = jax.random.split(runner.key, 3)
-        q_values = network.apply(runner.params, runner.obs)
-        action = epsilon_greedy(q_values, action_key, epsilon)
-        obs, env_state, reward, terminated, truncated, info = v_step(
-            jax.random.split(step_key, n), runner.env_state, action, env_params)
-        # A time limit is not a terminal state: a truncated episode is credited gamma * max Q of its
-        # last observation. Rare, so the network runs on it only then.
-        final_q = jax.lax.cond(jax_training.any_over_seeds(truncated, config.num_seeds),
-                               lambda: network.apply(runner.params, info["final_observation"]).max(axis=1),
-                               lambda: jnp.zeros(n, jnp.float32))
-        done = terminated | truncated
-        episode_return = runner.episode_return + reward
-        transition = Transition(runner.obs, action, q_values.max(axis=1),
-                                reward + config.gamma * jnp.where(truncated, final_q, 0.0),
-                                done, jnp.where(done, episode_return, 0.0))
-        runner = runner._replace(env_state=env_state, obs=obs, key=key,
-                                 episode_return=jnp.where(done, 0.0, episode_return))
-        return (runner, epsilon), transition
+    def max_q(params, obs):
+        return network.apply(params, obs).max(axis=1)
 
-    def update(runner: RunnerState):
+    rollout = jax_update.make_rollout(config, env, env_params, explore, max_q)
+    learn = jax_update.make_learn(config, optimizer, lambda params, minibatch: _td_loss(params, network, minibatch))
+
+    def update(runner: jax_update.RunnerState):
         epsilon = config.epsilon(runner.updates)
-        (runner, _), traj = jax.lax.scan(env_step, (runner, epsilon), None, config.num_steps)
-        last_q = network.apply(runner.params, runner.obs).max(axis=1)
-        targets = q_lambda_targets(traj, last_q, config.gamma, config.q_lambda)
-        batch = (traj.obs, traj.action, targets)
-        batch = jax.tree.map(lambda x: x.reshape((config.batch_size,) + x.shape[2:]), batch)
-        params, opt_state, key, stats = jax_training.run_epochs(
-            config, sgd_step, batch, runner.params, runner.opt_state, runner.key)
-        metrics = {k: v.mean() for k, v in stats.items()}
-        metrics["target_mean"] = targets.mean()
-        metrics["epsilon"] = epsilon
-        metrics["finished_return_sum"] = traj.finished_return.sum()
-        metrics["finished_episodes"] = traj.done.sum()
-        runner = runner._replace(params=params, opt_state=opt_state, key=key, updates=runner.updates + 1)
+        runner, traj = rollout(runner, epsilon)
+        targets = q_lambda_targets(traj.reward, traj.done, traj.policy_out, max_q(runner.params, runner.obs),
+                                   config.gamma, config.q_lambda)
+        runner, metrics = learn(runner, (traj.obs, traj.action, targets))
+        metrics.update(target_mean=targets.mean(), epsilon=epsilon, **jax_update.episode_totals(traj))
         return runner, metrics
-
-    def sgd_step(carry, minibatch):
-        params, opt_state = carry
-        grads, stats = jax.grad(_td_loss, has_aux=True)(params, network, minibatch)
-        updates, opt_state = optimizer.update(grads, opt_state, params)
-        return (optax.apply_updates(params, updates), opt_state), stats
 
     def act(params, key, obs):
         return epsilon_greedy(network.apply(params, obs), key, config.eval_epsilon)
 
-    return Trainer("PQN", network, init, update, act, lambda runner: runner.params, METRICS,
+    return Trainer("PQN", network, jax_update.make_init(config, env, env_params, network, optimizer), update, act,
+                   lambda runner: runner.params, METRICS,
                    lambda i: {"learning_rate": config.learning_rate_at(i), "epsilon": float(config.epsilon(i))})
 
 
-def q_lambda_targets(traj: Transition, last_q: jax.Array, gamma: float, lam: float) -> jax.Array:
-    """Q(lambda) returns, (num_steps, num_envs), computed backwards over the rollout:
+def q_lambda_targets(reward: jax.Array, done: jax.Array, q_max: jax.Array, last_q: jax.Array, gamma: float,
+                     lam: float) -> jax.Array:
+    """Q(lambda) returns, (num_steps, num_envs) as the inputs, computed backwards over the rollout:
 
         G_t = r_t + gamma * (1 - done_t) * (lam * G_{t+1} + (1 - lam) * max_a Q(s_{t+1}, a))
 
-    with G_T = max_a Q(s_T, a) after the last step, so lam = 0 is one-step Q-learning and lam = 1
-    the discounted return bootstrapped at the rollout's end. `traj.q_max[t + 1]` is
-    max_a Q(s_{t+1}, a); where step t ended an episode, s_{t+1} is the next episode's start and
+    with G_T = max_a Q(s_T, a) after the last step (`last_q`, (num_envs,)), so lam = 0 is one-step
+    Q-learning and lam = 1 the discounted return bootstrapped at the rollout's end. `q_max[t + 1]`
+    is max_a Q(s_{t+1}, a); where step t ended an episode, s_{t+1} is the next episode's start and
     (1 - done_t) cuts it off.
     """
-    def backward(carry, t):
+    def backward(carry, step):
         next_return, next_q_max = carry
-        not_done = 1.0 - t.done.astype(jnp.float32)
-        target = t.reward + gamma * not_done * (lam * next_return + (1.0 - lam) * next_q_max)
-        return (target, t.q_max), target
+        reward, done, q_max = step
+        not_done = 1.0 - done.astype(jnp.float32)
+        target = reward + gamma * not_done * (lam * next_return + (1.0 - lam) * next_q_max)
+        return (target, q_max), target
 
-    _, targets = jax.lax.scan(backward, (last_q, last_q), traj, reverse=True)
+    _, targets = jax.lax.scan(backward, (last_q, last_q), (reward, done, q_max), reverse=True)
     return targets
 
 
@@ -201,16 +149,9 @@ HELP = {
 }
 
 
-def parse_args(argv: Optional[Sequence[str]] = None) -> tuple[Config, Path]:
-    return jax_training.parse_args(Config, HELP, __doc__.split("\n\n")[0], "runs/jax_pqn", argv)
-
-
 def main(argv: Optional[Sequence[str]] = None) -> dict:
-    config, out_dir = parse_args(argv)
-    print(f"PQN on {config.game}: {config}")
-    summary = train(config, out_dir)
-    print(f"wrote {summary['csv']} and {summary['png']}")
-    return summary
+    """The command line (`jax_training.main`): flags, training, and the summary returned."""
+    return jax_training.main("PQN", Config, make_train, HELP, __doc__, "runs/jax_pqn", argv)
 
 
 if __name__ == "__main__":

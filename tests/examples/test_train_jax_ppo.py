@@ -54,9 +54,8 @@ def test_gae_matches_a_loop():
     reward, value = rng.normal(size=(steps, envs)), rng.normal(size=(steps, envs))
     done = rng.random((steps, envs)) < 0.3
     last_value = rng.normal(size=envs)
-    traj = ppo.Transition(None, None, None, jnp.asarray(value, jnp.float32), jnp.asarray(reward, jnp.float32),
-                          jnp.asarray(done), None)
-    advantages, targets = ppo._gae(traj, jnp.asarray(last_value, jnp.float32), gamma, lam)
+    rollout = (jnp.asarray(reward, jnp.float32), jnp.asarray(done), jnp.asarray(value, jnp.float32))
+    advantages, targets = ppo._gae(*rollout, jnp.asarray(last_value, jnp.float32), gamma, lam)
     expected, running = np.zeros((steps, envs)), np.zeros(envs)
     for t in reversed(range(steps)):
         next_value = last_value if t == steps - 1 else value[t + 1]

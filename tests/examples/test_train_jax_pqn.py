@@ -44,9 +44,8 @@ def test_q_lambda_targets_match_a_loop():
     reward, q_max = rng.normal(size=(steps, envs)), rng.normal(size=(steps, envs))
     done = rng.random((steps, envs)) < 0.3
     last_q = rng.normal(size=envs)
-    traj = pqn.Transition(None, None, jnp.asarray(q_max, jnp.float32), jnp.asarray(reward, jnp.float32),
-                          jnp.asarray(done), None)
-    targets = pqn.q_lambda_targets(traj, jnp.asarray(last_q, jnp.float32), gamma, lam)
+    rollout = (jnp.asarray(reward, jnp.float32), jnp.asarray(done), jnp.asarray(q_max, jnp.float32))
+    targets = pqn.q_lambda_targets(*rollout, jnp.asarray(last_q, jnp.float32), gamma, lam)
     # The lambda-return written out as a sum: from step t, the n-step returns bootstrapped with
     # max Q after k steps, weighted (1 - lam) lam^(k-1), the rest of the weight on the last one.
     expected = np.zeros((steps, envs))
@@ -68,7 +67,7 @@ def test_q_lambda_targets_match_a_loop():
             expected[t, e] = value
     np.testing.assert_allclose(targets, expected, rtol=1e-5, atol=1e-5)
     # lam = 0: one-step Q-learning targets.
-    one_step = pqn.q_lambda_targets(traj, jnp.asarray(last_q, jnp.float32), gamma, 0.0)
+    one_step = pqn.q_lambda_targets(*rollout, jnp.asarray(last_q, jnp.float32), gamma, 0.0)
     next_q = np.concatenate([q_max[1:], last_q[None]])
     np.testing.assert_allclose(one_step, reward + gamma * ~done * next_q, rtol=1e-5, atol=1e-5)
 
