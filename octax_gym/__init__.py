@@ -13,8 +13,10 @@ imported only when asked for. See docs/gymnasium.md.
 """
 
 from octax_gym.action_check import InvalidActionError
+from octax_gym.choices import UnknownOptionError
 from octax_gym.env import OctaxEnv
-from octax_gym.registration import NAMESPACE, env_id, register_all, register_game
+from octax_gym.game_names import NAMESPACE, env_id
+from octax_gym.registration import register_all, register_game
 from octax_gym.render import PALETTES
 from octax_gym.vector import OctaxVectorEnv
 
@@ -34,4 +36,5 @@ def __getattr__(name: str):
     raise AttributeError(f"module 'octax_gym' has no attribute {name!r}")
 
 
-__all__ = ["ENV_IDS", "InvalidActionError", "NAMESPACE", "OctaxEnv", "OctaxVectorEnv", "PALETTES", "env_id", "register_all", "register_game", *_LAZY]
+__all__ = ["ENV_IDS", "InvalidActionError", "NAMESPACE", "OctaxEnv", "OctaxVectorEnv", "PALETTES", "UnknownOptionError",
+           "env_id", "register_all", "register_game", *_LAZY]

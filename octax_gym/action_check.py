@@ -1,4 +1,10 @@
-"""Range checks of actions that live on a device, raised without making the step wait for them.
+"""Every check of an action, in one place: host actions at once, device ones without a wait.
+
+Every way an action reaches a game goes through here: `OctaxVectorEnv.step` (and the SB3 and
+TorchRL adapters above it) by `to_device`, `OctaxEnv.step` by `to_int`, the dataset collector's
+policy outputs by `check_batch`, so a bad action gets the same error, with the same words,
+whatever brought it: TypeError for a wrong type or dtype, ValueError for a wrong shape, and
+`InvalidActionError` (a ValueError) for a value outside 0..num_actions-1.
 
 Actions that arrive on the host (numpy arrays, lists, ints) are checked before the step, on the
 host: an out-of-range one raises at once and nothing runs. Actions that arrive as JAX arrays or
@@ -19,10 +25,11 @@ oldest report is waited for: the device is that far behind, so the wait costs no
 from __future__ import annotations
 
 import collections
-from typing import Optional
+from typing import Any, Optional
 
 import jax
 import jax.numpy as jnp
+import numpy as np
 
 MAX_PENDING = 64
 NO_REPORT = (0, -1, 0)  # (out-of-range actions, first env, its action)
@@ -30,6 +37,104 @@ NO_REPORT = (0, -1, 0)  # (out-of-range actions, first env, its action)
 
 class InvalidActionError(ValueError):
     """An action outside 0..num_actions-1; the message names it, its env and the valid range."""
+
+
+# --- on the host, before the step ---------------------------------------------------------------
+
+
+def to_device(actions, num_envs: int, num_actions: int, device: jax.Device,
+              game: str) -> tuple[jax.Array, bool]:
+    """A batch of actions (numpy, list, jax or torch) as an int32 JAX array on the env's device.
+
+    Everything is checked that can be without waiting for a device: the type, the integer
+    dtype and the shape (num_envs,) always, from metadata; the values too when they are on the
+    host (numpy, lists). JAX arrays and torch tensors are never read here: their range is checked
+    inside the jitted step (`accumulate`, `DeferredCheck`).
+
+    Returns:
+        The actions, and whether their values are still unchecked (device inputs).
+
+    Raises:
+        TypeError: wrong type or dtype. ValueError: wrong shape. InvalidActionError: a host
+        value out of range.
+    """
+    torch = _torch_if_tensor(actions)
+    if torch is not None:
+        if actions.dtype.is_floating_point or actions.dtype.is_complex or actions.dtype == torch.bool:
+            raise TypeError(f"{game}: actions must be integers, got a torch tensor of {actions.dtype}")
+        _check_shape(tuple(actions.shape), num_envs, game)
+        # A private int32 copy (an async op on the tensor's stream), handed over by DLPack: the
+        # caller may overwrite its tensor while the step still runs, and no value is read here.
+        copy = actions.detach().to(dtype=torch.int32, copy=True).contiguous()
+        return jax.device_put(jax.dlpack.from_dlpack(copy), device), True
+    if isinstance(actions, jax.Array):
+        _check_integer_dtype(actions.dtype, num_envs, num_actions, game)
+        _check_shape(actions.shape, num_envs, game)
+        return jax.device_put(actions.astype(jnp.int32), device), True
+    array = check_batch(actions, num_envs, num_actions, game)
+    return jax.device_put(array.astype(np.int32), device), False
+
+
+def check_batch(actions: Any, num_envs: int, num_actions: int, game: str, source: str = "") -> np.ndarray:
+    """A batch of actions read on the host (`np.asarray`), checked: integers, shape (num_envs,),
+    values in 0..num_actions-1. `source` says where they came from ("from the policy").
+
+    Raises:
+        TypeError: not integers. ValueError: wrong shape. InvalidActionError: a value out of range.
+    """
+    who = f"{game}, {source}" if source else game
+    array = np.asarray(actions)
+    _check_integer_dtype(array.dtype, num_envs, num_actions, who)
+    _check_shape(array.shape, num_envs, who)
+    if array.size and (array.min() < 0 or array.max() >= num_actions):
+        raise _out_of_range(array.min() if array.min() < 0 else array.max(), num_actions, who)
+    return array
+
+
+def to_int(action: Any, num_actions: int, game: str) -> int:
+    """One action (python int, numpy integer, 0-d array or tensor) -> int, checked.
+
+    Raises:
+        TypeError: not one integer. InvalidActionError: out of range.
+    """
+    torch = _torch_if_tensor(action)
+    value = action.detach().cpu().numpy() if torch is not None else np.asarray(action)
+    if value.shape != () or not np.issubdtype(value.dtype, np.integer) or value.dtype == np.bool_:
+        raise TypeError(f"{game}: an action is one integer in 0..{num_actions - 1}, "
+                        f"got {value.dtype} of shape {value.shape}")
+    if not 0 <= int(value) < num_actions:
+        raise _out_of_range(int(value), num_actions, game)
+    return int(value)
+
+
+def _check_integer_dtype(dtype, num_envs: int, num_actions: int, who: str) -> None:
+    if not np.issubdtype(dtype, np.integer) or dtype == np.bool_:
+        raise TypeError(f"{who}: actions must be integers, got {dtype} "
+                        f"(expected shape ({num_envs},), values 0..{num_actions - 1})")
+
+
+def _check_shape(shape: tuple, num_envs: int, who: str) -> None:
+    if tuple(shape) != (num_envs,):
+        raise ValueError(f"{who}: actions must have shape ({num_envs},), one per env, got {tuple(shape)}")
+
+
+def _out_of_range(value: int, num_actions: int, who: str, detail: str = "") -> InvalidActionError:
+    """The one wording of an out-of-range action, host or device."""
+    return InvalidActionError(f"{who}: action {value} is out of range; valid actions are 0..{num_actions - 1}{detail}")
+
+
+def _torch_if_tensor(value):
+    """The torch module when `value` is a torch tensor (without importing torch otherwise)."""
+    module = type(value).__module__
+    if module.startswith("torch"):
+        import torch
+
+        if isinstance(value, torch.Tensor):
+            return torch
+    return None
+
+
+# --- on the device, inside the step -------------------------------------------------------------
 
 
 def accumulate(report: jax.Array, actions: jax.Array, num_actions: int) -> jax.Array:
@@ -83,8 +188,7 @@ class DeferredCheck:
         count, env, value = (int(v) for v in jax.device_get(ready[1]))
         if count:
             self._pending.clear()  # the next step starts from a clean report
-            raise InvalidActionError(
-                f"{self.game}: action {value} is out of range; valid actions are 0..{self.num_actions - 1} "
-                f"(env {env}, in a device array by step {ready[0]} of this env, whose "
+            raise _out_of_range(value, self.num_actions, self.game, (
+                f" (env {env}, in a device array by step {ready[0]} of this env, whose "
                 f"range is checked inside the jitted step (so that steps never wait for the device): "
-                f"{count} out-of-range action(s) since the last check, each holding no key for its step)")
+                f"{count} out-of-range action(s) since the last check, each holding no key for its step)"))

@@ -30,6 +30,7 @@ from gymnasium.vector import AutoresetMode
 import octax_core
 from octax_core.env import ENV_OPTIONS, Env, EnvConfig, EnvParams, EnvState, GameSpec
 from octax_gym import action_check
+from octax_gym.game_names import resolve_spec
 
 # What the Gymnasium envs pass to the core: every env option but `autoreset`, which Gymnasium's
 # own `autoreset_mode` replaces.
@@ -107,17 +108,11 @@ def _compiled_step(spec: GameSpec, config: EnvConfig, rom: Optional[str]) -> Com
 
 
 def build(game: Any, rom, options: dict[str, Any]) -> tuple[CompiledStep, EnvParams]:
-    """The cached compiled step and checked params for a game id or `GameSpec` and `GYM_ENV_OPTIONS`
-    keywords (None means the game's default)."""
-    spec = game if isinstance(game, GameSpec) else octax_core.get_spec(_check_game(game))
+    """The cached compiled step and checked params for a game (any name `game_names.resolve_spec`
+    takes, or a `GameSpec`) and `GYM_ENV_OPTIONS` keywords (None means the game's default)."""
+    spec = resolve_spec(game)
     config, params = octax_core.make_config(spec, autoreset=False, **options)  # checks every value
     return _compiled_step(spec, config, None if rom is None else str(rom)), params
-
-
-def _check_game(game) -> str:
-    if not isinstance(game, str):
-        raise TypeError(f"game must be a registered id (str) or a GameSpec, got {type(game).__name__}")
-    return game
 
 
 def seeds_for(seed, num_envs: int) -> list[int]:

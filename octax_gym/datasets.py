@@ -25,7 +25,7 @@ import shutil
 import time
 import warnings
 from pathlib import Path
-from typing import Any, Callable, Optional, Union
+from typing import Any, Optional
 
 import gymnasium
 import jax
@@ -37,12 +37,10 @@ from tqdm import tqdm
 
 from octax_core.validate import check_int
 from octax_gym import action_check, compiled_step
+from octax_gym.choices import check_names
 from octax_gym.compiled_step import GYM_ENV_OPTIONS, MAX_SEED
-from octax_gym.video import resolve_env_id
-
-# A policy maps the batched observation, uint8 (num_envs, frames_per_step, H, W), to one action
-# per env (ints in 0..n-1, shape (num_envs,)).
-Policy = Union[None, str, Callable[[np.ndarray], Any]]
+from octax_gym.game_names import resolve_env_id
+from octax_gym.policies import Act, Policy, check_policy, make_policy, policy_name
 
 FLUSH_STEPS = 20_000  # finished episodes are written once they hold this many steps (~160 MB of CHIP-8 frames)
 INSTALL_HINT = 'pip install "octax-gym[datasets]"'
@@ -80,15 +78,15 @@ def collect_dataset(env_id: str, dataset_id: str, num_steps: int, *, num_envs: i
     arguments give the same dataset.
 
     Args:
-        env_id: a game id ("Brix") or its Gymnasium id ("octax/Brix-v0").
+        env_id: a game id ("Brix") or its Gymnasium id ("octax/Brix-v0"), in any case.
         dataset_id: Minari's `namespace/name-vN` (namespace optional; letters, digits, '-', '_';
             the version -vN is required), written under MINARI_DATASETS_PATH (default
             ~/.minari/datasets).
         num_steps: transitions to store in all, >= 1 (the last batched step may fill only some lanes).
         num_envs: lanes stepped together, >= 1.
-        policy: None or "random" (uniform actions drawn from `seed`), "noop" (action 0), or a
-            function from the batched observation, numpy uint8 (num_envs, frames_per_step, H, W),
-            to one action per lane (ints in 0..n-1, shape (num_envs,)), e.g. a trained agent.
+        policy: None or "random" (uniform actions drawn from `seed`), "noop" (action 0)
+            (`octax_gym.policies.POLICIES`), or a function from the batched observation, numpy
+            uint8 (num_envs, frames_per_step, H, W), to one action per lane (ints in 0..n-1, shape (num_envs,)), e.g. a trained agent.
         seed: the first episode seed, 0 <= seed and seed + num_envs + num_steps <= 2**32.
         overwrite: replace a dataset of that id; otherwise an existing one is an error.
         progress: a tqdm progress bar on stderr.
@@ -104,9 +102,12 @@ def collect_dataset(env_id: str, dataset_id: str, num_steps: int, *, num_envs: i
         A `CollectResult`: the `minari.MinariDataset`, its id and folder, episodes, steps, seconds.
 
     Raises:
-        ValueError: an unknown game or env option, a malformed or existing dataset id, bad
-            num_steps, num_envs, seed or policy name, or a policy returning a wrong batch of
-            actions; each message names the valid choices.
+        UnknownOptionError: an unknown game, env option or policy name; the message names the
+            valid choices.
+        ValueError: a malformed or existing dataset id, bad num_steps, num_envs or seed, or a
+            policy returning a wrong shape of actions (`InvalidActionError`, a ValueError, for
+            one out of range).
+        TypeError: a policy returning actions that are not integers.
         ImportError: Minari (the `datasets` extra) is not installed.
     """
     minari = _import_minari()
@@ -116,16 +117,17 @@ def collect_dataset(env_id: str, dataset_id: str, num_steps: int, *, num_envs: i
     check_int("seed", seed, minimum=0, maximum=MAX_SEED - num_envs - num_steps)
     check_int("flush_steps", flush_steps)
     _check_dataset_id(dataset_id)
-    _check_env_options(env_options)
+    check_names("env option(s)", env_options, GYM_ENV_OPTIONS)
+    check_policy(policy)
     path = minari.storage.get_dataset_path(dataset_id)
     if path.exists() and not overwrite:
         raise ValueError(f"dataset {dataset_id!r} already exists at {path}; pass overwrite=True "
                          "(--overwrite) to replace it, or pick another name or version")
     lanes = _Lanes(gymnasium.spec(gym_id).kwargs["game"], num_envs, env_options)  # checks the options' values
-    act = _make_policy(policy, num_envs, lanes.num_actions, seed)
-    metadata = {"algorithm_name": _policy_name(policy), "author": author, "author_email": author_email,
+    act = make_policy(policy, num_envs, lanes.num_actions, seed)
+    metadata = {"algorithm_name": policy_name(policy), "author": author, "author_email": author_email,
                 "code_permalink": code_permalink,
-                "description": description or (f"{gym_id}, {_policy_name(policy)} policy, {num_steps} steps from "
+                "description": description or (f"{gym_id}, {policy_name(policy)} policy, {num_steps} steps from "
                                                f"{num_envs} lanes, episode seeds from {seed}: collected by "
                                                "octax_gym.datasets.collect_dataset")}
     if path.exists():
@@ -201,7 +203,7 @@ class _Episode:
             truncations=truncations, infos={name: np.array(values) for name, values in self.infos.items()})
 
 
-def _collect(lanes: "_Lanes", act: Callable[[np.ndarray], Any], num_steps: int, seed: int,
+def _collect(lanes: "_Lanes", act: Act, num_steps: int, seed: int,
              writer: "_Writer", bar: tqdm) -> None:
     """Steps every lane at once until `num_steps` transitions are stored, starting a new episode
     in a lane, with the next unused seed, as soon as its episode ends."""
@@ -211,7 +213,7 @@ def _collect(lanes: "_Lanes", act: Callable[[np.ndarray], Any], num_steps: int, 
     next_seed = seed + num_envs
     left = num_steps
     while left > 0:
-        actions = _check_actions(act(obs), num_envs, lanes.num_actions, lanes.game)
+        actions = action_check.check_batch(act(obs), num_envs, lanes.num_actions, lanes.game, "from the policy")
         last, reward, terminated, truncated, info, obs, first_info, seeds = lanes.step(actions, next_seed)
         used = min(num_envs, left)  # the last batched step may fill only the first lanes
         for lane in range(used):
@@ -331,7 +333,7 @@ class _Writer:
         self._pending, self._pending_steps = [], 0
 
 
-# --- checks and policies ---------------------------------------------------------------------
+# --- checks ----------------------------------------------------------------------------------
 
 
 def _import_minari():
@@ -354,53 +356,3 @@ def _check_dataset_id(dataset_id) -> None:
         raise ValueError(f"dataset_id must look like 'namespace/name-v0' (Minari's format: an optional "
                          f"namespace/, a name of letters, digits, '-' and '_', and a version -vN), "
                          f"got {dataset_id!r}")
-
-
-def _check_env_options(options: dict) -> None:
-    unknown = sorted(set(options) - set(GYM_ENV_OPTIONS))
-    if unknown:
-        raise ValueError(f"unknown env option(s) {unknown}; valid: {', '.join(GYM_ENV_OPTIONS)}")
-
-
-def _check_actions(actions, num_envs: int, num_actions: int, game: str) -> np.ndarray:
-    """The policy's output as an int64 array, or an error saying what a batch of actions must be."""
-    values = np.asarray(actions)
-    if values.shape != (num_envs,) or not np.issubdtype(values.dtype, np.integer):
-        raise ValueError(f"the policy must return {num_envs} integer actions, shape ({num_envs},), "
-                         f"got {values.dtype} of shape {values.shape}")
-    if values.size and (values.min() < 0 or values.max() >= num_actions):
-        raise ValueError(f"the policy returned actions out of range ({values.min()}..{values.max()}); "
-                         f"{game}'s actions are 0..{num_actions - 1}")
-    return values.astype(np.int64)
-
-
-def _random_policy(num_envs: int, num_actions: int, seed: int) -> Callable[[np.ndarray], np.ndarray]:
-    generator = np.random.default_rng(seed)
-    return lambda obs: generator.integers(0, num_actions, num_envs)
-
-
-def _noop_policy(num_envs: int, num_actions: int, seed: int) -> Callable[[np.ndarray], np.ndarray]:
-    actions = np.zeros(num_envs, np.int64)
-    return lambda obs: actions
-
-
-# name -> (num_envs, num_actions, seed) -> policy
-POLICIES: dict[str, Callable[[int, int, int], Callable[[np.ndarray], np.ndarray]]] = {
-    "random": _random_policy,  # uniform over the actions, from numpy's generator seeded with `seed`
-    "noop": _noop_policy,  # action 0 (no key) in every lane
-}
-
-
-def _make_policy(policy: Policy, num_envs: int, num_actions: int, seed: int) -> Callable[[np.ndarray], Any]:
-    if callable(policy):
-        return policy
-    if policy is None or policy in POLICIES:
-        return POLICIES[policy or "random"](num_envs, num_actions, seed)
-    raise ValueError(f"unknown policy {policy!r}; valid: None, {', '.join(map(repr, POLICIES))} "
-                     "or a function from a batch of observations to a batch of actions")
-
-
-def _policy_name(policy: Policy) -> str:
-    if callable(policy):
-        return getattr(policy, "__qualname__", type(policy).__name__)
-    return policy or "random"

@@ -1,4 +1,4 @@
-"""`OctaxEnv`: one CHIP-8 game as a `gymnasium.Env`, the env behind `gymnasium.make`.
+"""`OctaxEnv`: one game (CHIP-8, SUPER-CHIP or XO-CHIP) as a `gymnasium.Env`, behind `gymnasium.make`.
 
 It runs the same compiled env step as `OctaxVectorEnv` with a batch of one, so a single env
 seeded s and row i of a vector env seeded s - i play the same game step for step. For many envs
@@ -13,7 +13,8 @@ import gymnasium
 import numpy as np
 
 from octax_core.env.config import check_option_names
-from octax_gym import backends
+from octax_gym import action_check
+from octax_gym.choices import UnknownOptionError
 from octax_gym.vector import FRAMES_PER_SECOND, KEYWORDS, OctaxVectorEnv
 
 SINGLE_KEYWORDS = tuple(k for k in KEYWORDS if k != "autoreset_mode")  # a single env never autoresets
@@ -43,7 +44,7 @@ class OctaxEnv(gymnasium.Env):
     def reset(self, *, seed: Optional[int] = None, options: Optional[dict] = None):
         super().reset(seed=seed)
         if options:
-            raise ValueError(f"OctaxEnv.reset takes no options, got {sorted(options)}")
+            raise UnknownOptionError("reset option(s)", sorted(options), (), "none (OctaxEnv.reset takes no options)")
         if seed is None and self._vector.state is None:
             seed = int(self.np_random.integers(0, 2**31 - 1))
         obs, info = self._vector.reset(seed=seed, options=None if self._vector.state is None
@@ -51,7 +52,7 @@ class OctaxEnv(gymnasium.Env):
         return obs[0], self._unbatch(info)
 
     def step(self, action):
-        value = backends.action_to_int(action, self.action_space.n, self.game_spec.id)
+        value = action_check.to_int(action, self.action_space.n, self.game_spec.id)
         obs, reward, terminated, truncated, info = self._vector.step(np.array([value], np.int32))
         return obs[0], float(reward[0]), bool(terminated[0]), bool(truncated[0]), self._unbatch(info)
 

@@ -8,20 +8,14 @@ import). Each id has an `entry_point` (`gymnasium.make` -> `OctaxEnv`) and a `ve
 
 from __future__ import annotations
 
-import gymnasium
-
 import os
 from pathlib import Path
 from typing import Optional, Union
 
+import gymnasium
+
 from octax_core.env.games import GameSpec, get_spec, list_games
-
-NAMESPACE = "octax"
-
-
-def env_id(game: str) -> str:
-    """The Gymnasium id of a registered game, e.g. "Pong" -> "octax/Pong-v0"."""
-    return f"{NAMESPACE}/{game}-v{get_spec(game).version}"
+from octax_gym.game_names import NAMESPACE, env_id  # noqa: F401  (where benchmarks and users import them)
 
 
 def register_all() -> list[str]:
@@ -60,7 +54,7 @@ def register_game(spec: GameSpec, rom: Optional[Union[str, os.PathLike]] = None)
                          f"(built-in ids: {', '.join(list_games())})")
     if rom is not None and not Path(rom).is_file():
         raise FileNotFoundError(f"ROM file not found: {rom}")
-    gym_id = f"{NAMESPACE}/{spec.id}-v{spec.version}"
+    gym_id = env_id(spec)
     gymnasium.register(
         id=gym_id,
         entry_point="octax_gym.env:OctaxEnv",

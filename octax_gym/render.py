@@ -12,6 +12,7 @@ import cv2
 import numpy as np
 
 from octax_core.validate import check_int
+from octax_gym.choices import check_choice
 
 RGB = tuple[int, int, int]
 
@@ -39,12 +40,11 @@ def resolve_palette(palette: PaletteArg) -> np.ndarray:
     quarter of the way (CHIP-8 and SUPER-CHIP pixels only ever use the first two).
 
     Raises:
-        ValueError: an unknown name (the message lists the valid ones) or a malformed set.
+        UnknownOptionError: an unknown name; the message lists the valid ones.
+        ValueError: a malformed set.
     """
     if isinstance(palette, str):
-        if palette not in PALETTES:
-            raise ValueError(f"unknown palette {palette!r}; valid: {', '.join(PALETTES)} "
-                             "or an (off, on) pair of RGB triples")
+        check_choice("palette", palette, PALETTES, "or an (off, on) pair of RGB triples")
         return np.array(PALETTES[palette], np.uint8)
     try:
         colours = np.array(palette)

@@ -32,6 +32,8 @@ from typing import Callable, Optional, Sequence
 import numpy as np
 from scipy import stats
 
+from octax_gym.choices import UnknownOptionError
+
 REFERENCE_SOURCES = ("search", "scripted", "trained")  # where a reference may come from (docs/scores.md)
 Statistic = Callable[[np.ndarray], float]
 
@@ -168,12 +170,12 @@ def normalized_score(game_id: str, score):
     `score` may be a number or an array of them (a float or a float array comes back).
 
     Raises:
-        KeyError: a game the table does not list.
+        UnknownOptionError: a game the table does not list (a KeyError and a ValueError).
         ValueError: a game with no reference (its `reference_detail` says why).
     """
     table = score_table()
     if game_id not in table:
-        raise KeyError(f"no scores for {game_id!r}; the table lists {', '.join(sorted(table))}")
+        raise UnknownOptionError("scored game", game_id, sorted(table))
     row = table[game_id]
     if row.reference is None:
         raise ValueError(f"{game_id} has no normalized score: {row.reference_detail}")

@@ -25,20 +25,28 @@ from octax_gym import action_check, backends, compiled_step, render
 from octax_core.emulator.state import screen_values
 from octax_core.env.config import check_option_names
 from octax_core.validate import check_int
+from octax_gym.choices import UnknownOptionError, check_choice, check_names
 from octax_gym.compiled_step import GYM_ENV_OPTIONS, build, keys_from_seeds, seeds_for
 
-FRAMES_PER_SECOND = 60  # the CHIP-8 timer rate; a step lasts frames_per_step of these frames
+FRAMES_PER_SECOND = 60  # the timer rate, on all three platforms; a step lasts frames_per_step frames
+RENDER_MODES = (None, "rgb_array")
+RESET_OPTIONS = ("reset_mask",)
 
 
 def check_autoreset_mode(mode) -> AutoresetMode:
+    """An `AutoresetMode`, or its name in any case, with or without underscores ("same_step").
+
+    Raises:
+        UnknownOptionError: anything else; the message lists the names.
+    """
     if isinstance(mode, AutoresetMode):
         return mode
     for member in AutoresetMode:
         if isinstance(mode, str) and mode.lower().replace("_", "") in (member.value.lower(), member.name.lower().replace("_", "")):
             return member
-    raise ValueError(f"unknown autoreset_mode {mode!r}; valid: "
-                     + ", ".join(f"AutoresetMode.{m.name}" for m in AutoresetMode)
-                     + " (or the strings 'next_step', 'same_step', 'disabled')")
+    members = ", ".join(f"AutoresetMode.{member.name}" for member in AutoresetMode)
+    raise UnknownOptionError("autoreset_mode", mode, [member.name.lower() for member in AutoresetMode],
+                             f"or an AutoresetMode ({members})")
 
 
 class OctaxVectorEnv(gymnasium.vector.VectorEnv):
@@ -59,7 +67,8 @@ class OctaxVectorEnv(gymnasium.vector.VectorEnv):
         `reset(options={"reset_mask": mask})`.
 
     Args:
-        game: a registered game id ("Pong"; see `octax_core.list_games()`) or a `GameSpec`.
+        game: a registered game id ("Pong"; see `octax_core.list_games()`), its Gymnasium id
+            ("octax/Pong-v0"), either in any case (`octax_gym.game_names`), or a `GameSpec`.
         num_envs: number of envs in the batch.
         autoreset_mode: see above.
         backend: "numpy" (default), "jax" or "torch"; arrays are handed over without copies.
@@ -90,9 +99,7 @@ class OctaxVectorEnv(gymnasium.vector.VectorEnv):
         self.autoreset_mode = check_autoreset_mode(autoreset_mode)
         self.backend = backends.check_backend(backend)
         self.device = backends.resolve_device(device)
-        if render_mode not in (None, "rgb_array"):
-            raise ValueError(f"unknown render_mode {render_mode!r}; valid: None, 'rgb_array'")
-        self.render_mode = render_mode
+        self.render_mode = check_choice("render_mode", render_mode, RENDER_MODES)
         self.render_scale = render.check_render_scale(render_scale)
         if palette is not None:
             self.palette = render.resolve_palette(palette)  # a bad one raises before the build
@@ -125,8 +132,7 @@ class OctaxVectorEnv(gymnasium.vector.VectorEnv):
         super().reset(seed=int(seed) if isinstance(seed, (int, np.integer)) else None)
         options = dict(options or {})
         mask = options.pop("reset_mask", None)
-        if options:
-            raise ValueError(f"unknown reset option(s) {sorted(options)}; valid: 'reset_mask'")
+        check_names("reset option(s)", options, RESET_OPTIONS)
         if mask is not None:
             mask = self._check_mask(mask)
         if self._state is None or seeds is not None:
@@ -155,8 +161,8 @@ class OctaxVectorEnv(gymnasium.vector.VectorEnv):
         """
         if self._state is None:
             raise gymnasium.error.ResetNeeded("call reset() before step()")
-        actions, unchecked = backends.actions_to_device(actions, self.num_envs, self.single_action_space.n,
-                                                        self.device, self.game_spec.id)
+        actions, unchecked = action_check.to_device(actions, self.num_envs, self.single_action_space.n,
+                                                    self.device, self.game_spec.id)
         self._action_check.poll()
         self._keys, self._obs, self._state, reward, terminated, truncated, info, report = self._step_fn(
             self._keys, self._state, actions, self._action_check.report, self.params)

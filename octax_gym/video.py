@@ -20,23 +20,21 @@ import subprocess
 import tempfile
 from fractions import Fraction
 from pathlib import Path
-from typing import Any, Callable, Iterable, Iterator, Union
+from typing import Iterable, Iterator, Union
 
 import gymnasium
 import numpy as np
 from tqdm import tqdm
 
-import octax_gym
-from octax_core.env.games import list_games
 from octax_core.validate import check_int
 from octax_gym import render
+from octax_gym.game_names import resolve_env_id
+from octax_gym.policies import Act, Policy, check_policy, make_policy
 
 VIDEO_EXTRA_HINT = "pip install 'octax-gym[video]'"
 # x264's constant-quality setting: 18 is about visually lossless, and flat pixel art still
 # compresses to a few kB a second, so there is no reason to trade sharpness for size.
 CRF = 18
-
-Policy = Union[str, Callable[[Any], Any]]
 
 
 @dataclasses.dataclass(frozen=True)
@@ -176,22 +174,6 @@ def _check_frame(frame, index: int, shape) -> tuple[int, ...]:
 # --- recording a rollout ----------------------------------------------------------------------
 
 
-def _random_policy(envs: gymnasium.vector.VectorEnv, seed: int) -> Callable[[Any], Any]:
-    envs.action_space.seed(seed)
-    return lambda obs: envs.action_space.sample()
-
-
-def _noop_policy(envs: gymnasium.vector.VectorEnv, seed: int) -> Callable[[Any], Any]:
-    actions = np.zeros(envs.num_envs, np.int64)
-    return lambda obs: actions
-
-
-POLICIES: dict[str, Callable[[gymnasium.vector.VectorEnv, int], Callable[[Any], Any]]] = {
-    "random": _random_policy,  # uniform over the actions, from the action space seeded with `seed`
-    "noop": _noop_policy,  # action 0 (no key) in every env
-}
-
-
 def record(game: str, out: Union[str, os.PathLike], *, steps: int, policy: Policy = "random",
            num_envs: int = 1, seed: int = 0, progress: bool = True, **env_kwargs) -> RecordResult:
     """Plays `steps` steps of a game in `num_envs` envs and writes them as an H.264 mp4.
@@ -202,13 +184,13 @@ def record(game: str, out: Union[str, os.PathLike], *, steps: int, policy: Polic
     video runs on through episode ends.
 
     Args:
-        game: a game id ("Pong") or its Gymnasium id ("octax/Pong-v0").
+        game: a game id ("Pong") or its Gymnasium id ("octax/Pong-v0"), in any case.
         out: the .mp4 file to write (its folder is created if needed).
         steps: env steps to play, >= 1.
-        policy: "random", "noop" (see `POLICIES`), or a function from the batched observation
-            (num_envs, frames_per_step, 32, 64) to a batch of actions.
+        policy: None or "random", "noop" (`octax_gym.policies.POLICIES`), or a function from
+            the batched observation (num_envs, frames_per_step, 32, 64) to a batch of actions.
         num_envs: envs shown side by side, >= 1.
-        seed: seeds the envs (env i gets seed + i) and the random policy.
+        seed: seeds the envs (env i gets seed + i) and the random policy (numpy's generator).
         progress: show a tqdm progress bar (on stderr).
         **env_kwargs: `gymnasium.make_vec` keywords, e.g. render_scale=4, palette="amber",
             frames_per_step=2, max_episode_steps=500.
@@ -217,19 +199,19 @@ def record(game: str, out: Union[str, os.PathLike], *, steps: int, policy: Polic
         A `RecordResult`: the path, frames written, episodes ended, frame width and height, fps.
 
     Raises:
-        ValueError: an unknown game, policy or palette, or steps or num_envs < 1; each message
-            lists the valid choices.
+        UnknownOptionError: an unknown game, policy or palette; the message lists the valid choices.
+        ValueError: steps or num_envs < 1 (UnknownOptionError is a ValueError too).
         ImportError: the `video` extra is missing (checked before any emulation).
     """
     gym_id = resolve_env_id(game)
     check_int("steps", steps)
     check_int("num_envs", num_envs)
-    _check_policy(policy)
+    check_policy(policy)
     path = _check_mp4_path(out)
     _ffmpeg_exe()  # fail before minutes of compiling and playing, not after
     envs = gymnasium.make_vec(gym_id, num_envs=num_envs, render_mode="rgb_array", **env_kwargs)
     try:
-        act = _make_policy(policy, envs, seed)
+        act = make_policy(policy, num_envs, int(envs.single_action_space.n), seed)
         rollout = _Rollout(envs, act)
         first = rollout.reset(seed)
         bar = tqdm(total=steps, desc=f"recording {gym_id}", unit="step", disable=not progress)
@@ -245,7 +227,7 @@ def record(game: str, out: Union[str, os.PathLike], *, steps: int, policy: Polic
 class _Rollout:
     """Steps a vector env with a policy and renders each step as one frame, counting episode ends."""
 
-    def __init__(self, envs: gymnasium.vector.VectorEnv, act: Callable[[Any], Any]):
+    def __init__(self, envs: gymnasium.vector.VectorEnv, act: Act):
         self.envs, self.act = envs, act
         self.obs = None
         self.episodes = 0
@@ -264,28 +246,3 @@ class _Rollout:
     def frame(self) -> np.ndarray:
         screens = self.envs.render()
         return screens[0] if len(screens) == 1 else render.tile(screens)
-
-
-def resolve_env_id(game: str) -> str:
-    """The Gymnasium id for a game id or a Gymnasium id: "Pong" and "octax/Pong-v0" both give "octax/Pong-v0".
-
-    Raises:
-        ValueError: neither a game id nor a registered Gymnasium id; the message lists the valid ids.
-    """
-    if game in octax_gym.ENV_IDS:
-        return game
-    if isinstance(game, str) and game in list_games():
-        return octax_gym.env_id(game)
-    raise ValueError(f"unknown game {game!r}; valid: a game id ({', '.join(list_games())}) "
-                     f"or its Gymnasium id ({octax_gym.env_id(list_games()[0])}, ...)")
-
-
-def _check_policy(policy: Policy) -> None:
-    if not callable(policy) and policy not in POLICIES:
-        raise ValueError(f"unknown policy {policy!r}; valid: {', '.join(map(repr, POLICIES))} "
-                         "or a function from observations to actions")
-
-
-def _make_policy(policy: Policy, envs: gymnasium.vector.VectorEnv, seed: int) -> Callable[[Any], Any]:
-    return policy if callable(policy) else POLICIES[policy](envs, seed)
-

@@ -1,4 +1,4 @@
-"""What several `octax-gym` commands share: the registered specs, game-name lookup, tables, help.
+"""What several `octax-gym` commands share: the registered specs, tables, help.
 
 Every command module imports from here and never from another command module or from the
 parser (`octax_gym.cli`), so the command modules form no import circle.
@@ -23,16 +23,6 @@ def game_specs() -> list:
     from octax_core.env.games import get_spec, list_games
 
     return [get_spec(game_id) for game_id in list_games()]
-
-
-def lookup_spec(name: str):
-    """The spec for a game id or Gymnasium id, exact first, then ignoring case; None if unknown."""
-    from octax_core.env.games import get_spec, list_games
-    from octax_gym.registration import env_id
-
-    names = {game: game for game in list_games()} | {env_id(game): game for game in list_games()}
-    game = names.get(name) or {key.lower(): value for key, value in names.items()}.get(name.lower())
-    return None if game is None else get_spec(game)
 
 
 def print_table(rows: list[tuple[str, ...]]) -> None:

@@ -33,18 +33,20 @@ def add_commands(commands: argparse._SubParsersAction) -> None:
 def _cmd_list(args: argparse.Namespace) -> int:
     from octax_core.env import romstore
     from octax_core.env.games import CATEGORIES, SUITES, get_spec, list_games
+    from octax_gym.choices import UnknownOptionError
     from octax_gym.cli.common import print_table
-    from octax_gym.registration import env_id
+    from octax_gym.game_names import env_id
 
+    problem = None
     if args.suite is not None and args.suite not in SUITES:
-        print(f"octax-gym list: error: unknown suite {args.suite!r}; valid: {', '.join(SUITES)}", file=sys.stderr)
-        return 2
+        problem = UnknownOptionError("suite", args.suite, SUITES)
+    elif args.category is not None and args.category.lower() not in CATEGORIES:
+        problem = UnknownOptionError("category", args.category, CATEGORIES)
+    if problem is not None:
+        print(f"octax-gym list: error: {problem}", file=sys.stderr)
+        return 2  # a usage error, as argparse's own
     specs = [get_spec(game) for game in list_games(args.suite)]
     if args.category is not None:
-        if args.category.lower() not in CATEGORIES:
-            print(f"octax-gym list: error: unknown category {args.category!r}; valid: {', '.join(CATEGORIES)}",
-                  file=sys.stderr)
-            return 2
         specs = [spec for spec in specs if spec.category == args.category.lower()]
     if not specs:
         print("no games registered" + (f" in category {args.category.lower()}" if args.category else ""))
@@ -69,17 +71,9 @@ def _cmd_info(args: argparse.Namespace) -> int:
     from octax_core.emulator.platforms import resolve_platform
     from octax_core.emulator.state import screen_values_max, screen_values_shape
     from octax_core.emulator.quirks import resolve_quirks
-    from octax_gym.cli.common import lookup_spec
-    from octax_gym.registration import env_id
+    from octax_gym import game_names
 
-    spec = lookup_spec(args.game)
-    if spec is None:
-        from octax_core.env.games import list_games
-
-        games = list_games()
-        print(f"octax-gym info: error: unknown game {args.game!r}; valid ids: {', '.join(games) or 'none'}"
-              + (f" (or their Gymnasium ids, e.g. {env_id(games[0])})" if games else ""), file=sys.stderr)
-        return 1
+    spec = game_names.resolve_spec(args.game)  # an unknown name: UnknownOptionError, exit status 1
     config = make_config(spec)[0]  # what gym.make / make_vec use by default (the game's own speed and timers)
     quirks = resolve_quirks(spec.quirks)
     platform = resolve_platform(spec.platform)
@@ -109,7 +103,7 @@ def _cmd_info(args: argparse.Namespace) -> int:
         ("rom sha1", spec.rom_sha1),
         ("rom status", _rom_word(status) + (f" at {status.path}" if status.path else "")),
     ]
-    lines = [f"{spec.title}  ({env_id(spec.id)}, game id {spec.id!r}, version {spec.version})"]
+    lines = [f"{spec.title}  ({game_names.env_id(spec)}, game id {spec.id!r}, version {spec.version})"]
     for name, text in fields:
         lines.append(textwrap.fill(text, WIDTH, initial_indent=f"{name + ':' if name else '':19}",
                                    subsequent_indent=" " * 19, break_on_hyphens=False))

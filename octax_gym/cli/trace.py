@@ -16,7 +16,8 @@ import argparse
 import csv
 from pathlib import Path
 
-POLICIES = ("random", "noop")
+from octax_gym.policies import POLICIES
+
 MAX_PLOT_COLUMNS = 5  # --plot shows at most this many candidates per role
 _ROLE_TITLES = {"score": "score", "lives": "lives", "game_over": "game over"}
 
@@ -32,7 +33,7 @@ def add_commands(commands: argparse._SubParsersAction) -> None:
     trace.add_argument("game", metavar="GAME|ROM",
                        help="game id (Brix), Gymnasium id (octax/Brix-v0), or the path of a ROM file")
     trace.add_argument("--steps", type=int, default=2000, metavar="N", help="env steps per env (default 2000)")
-    trace.add_argument("--policy", choices=POLICIES, default="random",
+    trace.add_argument("--policy", choices=tuple(POLICIES), default="random",
                        help="random (default) or noop (no key ever held)")
     trace.add_argument("--envs", type=int, default=8, metavar="K", help="envs played side by side (default 8)")
     trace.add_argument("--seed", type=int, default=0, metavar="S", help="seeds the envs and the policy (default 0)")
@@ -77,18 +78,18 @@ def _resolve(name: str):
     """(spec, None) for a game id or Gymnasium id (any case); (None, path) for a ROM file.
 
     Raises:
-        ValueError: neither; the message lists the valid ids.
+        UnknownOptionError: neither; the message lists the valid ids.
     """
-    from octax_core.env.games import list_games
-    from octax_gym.cli.common import lookup_spec
+    from octax_gym.choices import UnknownOptionError
+    from octax_gym.game_names import resolve_spec
 
-    spec = lookup_spec(name)
-    if spec is not None:
-        return spec, None
-    if Path(name).is_file():
-        return None, Path(name)
-    raise ValueError(f"unknown game {name!r} and no ROM file at that path; valid ids: {', '.join(list_games())} "
-                     "(or their Gymnasium ids), or the path of a .ch8 file")
+    try:
+        return resolve_spec(name), None
+    except UnknownOptionError as unknown:
+        if Path(name).is_file():
+            return None, Path(name)
+        also = f"{unknown.also}, or the path of a ROM file (.ch8; there is no file {name!r})"
+        raise UnknownOptionError(unknown.what, name, unknown.choices, also) from None
 
 
 def _header(args: argparse.Namespace, trace, raw: bool) -> str:

@@ -11,8 +11,7 @@ import pytest
 from octax_core.env import environment as core_env
 from octax_core.env import romstore
 from octax_core.env.games import CATEGORIES, get_spec, list_games
-from octax_gym import cli, env_id
-from octax_gym.cli import common as cli_common
+from octax_gym import cli, env_id, game_names
 
 
 @pytest.fixture
@@ -76,7 +75,7 @@ def test_list_suite_filter(capsys):
     assert list(rows) == [env_id(g) for g in list_games(suite="ours") if get_spec(g).category == "reaction"] != []
     assert cli.main(["list", "--suite", "nes"]) == 2
     captured = capsys.readouterr()
-    assert captured.out == "" and "unknown suite 'nes'; valid: octax, ours" in captured.err
+    assert captured.out == "" and "unknown suite 'nes'; valid: 'octax', 'ours', 'archive'" in captured.err
 
 
 def test_list_unknown_category_is_a_usage_error_naming_the_valid_ones(capsys):
@@ -123,7 +122,7 @@ def test_info_shows_lives_frozen_timers_and_startup_keys(capsys):
 
 def test_info_shows_an_xochip_game_s_platform_and_observation(monkeypatch, capsys):
     xochip = dataclasses.replace(get_spec("Pong"), platform="xochip", quirks=None)  # no registered game is one yet
-    monkeypatch.setattr(cli_common, "lookup_spec", lambda name: xochip)
+    monkeypatch.setattr(game_names, "resolve_spec", lambda name: xochip)
     assert cli.main(["info", "Pong"]) == 0
     out = capsys.readouterr().out
     for expected in ("platform:          xochip", "Box(0, 3, (4, 64, 128), uint8)", "quirks:            xochip: vf_reset=False"):
@@ -132,7 +131,7 @@ def test_info_shows_an_xochip_game_s_platform_and_observation(monkeypatch, capsy
 
 def test_info_shows_frozen_timers(monkeypatch, capsys):
     frozen = dataclasses.replace(get_spec("Pong"), freeze_timers=True)  # no registered game freezes them
-    monkeypatch.setattr(cli_common, "lookup_spec", lambda name: frozen)
+    monkeypatch.setattr(game_names, "resolve_spec", lambda name: frozen)
     assert cli.main(["info", "Pong"]) == 0
     assert "timers:            frozen: delay and sound zeroed after every step" in capsys.readouterr().out
 
@@ -148,7 +147,7 @@ def test_info_unknown_game_fails_listing_the_valid_ids(name, capsys):
     assert cli.main(["info", name]) == 1
     captured = capsys.readouterr()
     assert captured.out == ""
-    assert f"unknown game {name!r}" in captured.err
+    assert captured.err.startswith(f"octax-gym: error: unknown game {name!r}")
     assert all(game in captured.err for game in list_games()) and "octax/Airplane-v0" in captured.err
 
 

@@ -1,4 +1,5 @@
-"""Actions on a device are never read back on the step path, and a bad one still raises.
+"""Actions on a device are never read back on the step path, and a bad one still raises; the
+host checks (last section) are the same module's, and every way an action comes in uses them.
 
 On a CPU `jax.transfer_guard` sees no transfers (host and device memory are the same), so the
 tests check what a read would cost instead: the actions come from a computation that is still
@@ -10,15 +11,19 @@ guard is set too, for a GPU.
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import jax
 import jax.numpy as jnp
 import numpy as np
 import pytest
 from jax._src.array import ArrayImpl  # the one class behind jax.Array; its _value is every host read
 
+import octax_gym
 from counter_game import COUNTER
 from octax_gym import OctaxVectorEnv
-from octax_gym.action_check import MAX_PENDING, DeferredCheck, InvalidActionError, accumulate
+from octax_gym.action_check import (MAX_PENDING, DeferredCheck, InvalidActionError, accumulate, check_batch, to_device,
+                                    to_int)
 
 
 def _no_waiting_reads(monkeypatch):
@@ -144,3 +149,53 @@ def test_a_host_far_ahead_of_the_device_waits_for_the_oldest_report():
     check.record(np.array([1, 2, 7], np.int32).view(_Unfinished), values_unchecked=True)
     with pytest.raises(InvalidActionError, match=r"action 7 is out of range; valid actions are 0\.\.2 \(env 2"):
         check.poll(wait=True)
+
+
+# --- the host checks: every way in goes through this module ------------------------------------
+
+
+@pytest.mark.parametrize("actions, error, message", [
+    (np.array([0, 1, 3]), InvalidActionError,
+     r"^Game, from the policy: action 3 is out of range; valid actions are 0\.\.2$"),
+    (np.array([-1, 0, 0]), InvalidActionError, "action -1 is out of range"),
+    (np.array([0.0, 1.0, 2.0]), TypeError, r"^Game, from the policy: actions must be integers, got float64"),
+    (np.zeros((3, 1), np.int64), ValueError, r"actions must have shape \(3,\), one per env, got \(3, 1\)$"),
+])
+def test_a_host_batch_gets_the_env_s_errors(actions, error, message):
+    with pytest.raises(error, match=message):
+        check_batch(actions, 3, 3, "Game", "from the policy")
+    assert check_batch([0, 2, 1], 3, 3, "Game").tolist() == [0, 2, 1]
+
+
+def test_out_of_range_is_one_error_type_on_the_host_and_the_device():
+    with pytest.raises(InvalidActionError, match=r"^Game: action 3 is out of range; valid actions are 0\.\.2$"):
+        to_int(3, 3, "Game")
+    with pytest.raises(InvalidActionError, match=r"^Game: action 5 is out of range; valid actions are 0\.\.2$"):
+        to_device(np.array([0, 5]), 2, 3, jax.devices()[0], "Game")
+    actions, unchecked = to_device(jnp.array([0, 5]), 2, 3, jax.devices()[0], "Game")
+    assert unchecked and actions.dtype == jnp.int32  # its range: the step's report (above)
+
+
+def test_the_envs_check_actions_only_through_this_module(counter_rom, monkeypatch):
+    from octax_gym import OctaxEnv, action_check
+
+    calls = []
+    for name in ("to_device", "to_int"):
+        checked = getattr(action_check, name)
+        monkeypatch.setattr(action_check, name,
+                            lambda *args, _checked=checked, _name=name: calls.append(_name) or _checked(*args))
+    envs = OctaxVectorEnv(COUNTER, 3, rom=counter_rom)
+    envs.reset(seed=0)
+    envs.step(np.array([0, 1, 2]))
+    env = OctaxEnv(COUNTER, rom=counter_rom)
+    env.reset(seed=0)
+    env.step(1)
+    assert calls == ["to_device", "to_int", "to_device"]  # the single env's one action, then its batch of one
+
+
+def test_no_other_module_of_the_user_layer_words_an_action_check():
+    package = Path(octax_gym.__file__).parent
+    wording = ("is out of range", "actions must", "an action is one integer")
+    modules = sorted(path.relative_to(package).as_posix() for path in package.rglob("*.py")
+                     if any(words in path.read_text() for words in wording))
+    assert modules == ["action_check.py"]

@@ -58,7 +58,7 @@ def test_device_argument(counter_rom):
     envs = OctaxVectorEnv(COUNTER, 2, rom=counter_rom, device=torch.device("cpu"))
     assert envs.device.platform == "cpu"
     if not any(d.platform == "gpu" for d in jax.devices()):
-        with pytest.raises(ValueError, match="unavailable device 'cuda'.*available: cpu:0"):
+        with pytest.raises(ValueError, match="unavailable device 'cuda'.*valid: 'cpu:0'"):
             OctaxVectorEnv(COUNTER, 2, rom=counter_rom, device="cuda")
     with pytest.raises(ValueError, match="unknown or unavailable device 'cpu:7'"):
         OctaxVectorEnv(COUNTER, 2, rom=counter_rom, device="cpu:7")

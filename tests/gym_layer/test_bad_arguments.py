@@ -9,7 +9,8 @@ import pytest
 
 import octax_gym  # noqa: F401
 from counter_game import COUNTER
-from octax_gym import OctaxEnv, OctaxVectorEnv
+from octax_gym import InvalidActionError, OctaxEnv, OctaxVectorEnv
+from octax_gym.choices import UnknownOptionError
 
 
 @pytest.fixture(scope="module")
@@ -22,11 +23,12 @@ def envs(counter_rom):
 @pytest.mark.parametrize("kwargs, error, message", [
     (dict(num_envs=0), ValueError, "num_envs must be an int >= 1"),
     (dict(num_envs=2.5), ValueError, "num_envs must be an int >= 1"),
-    (dict(backend="tensorflow"), ValueError, "valid: numpy, jax, torch"),
-    (dict(autoreset_mode="sometimes"), ValueError, "valid: AutoresetMode.NEXT_STEP"),
-    (dict(render_mode="human"), ValueError, "valid: None, 'rgb_array'"),
+    (dict(backend="tensorflow"), UnknownOptionError, "unknown backend 'tensorflow'; valid: 'numpy', 'jax', 'torch'"),
+    (dict(autoreset_mode="sometimes"), UnknownOptionError,
+     r"valid: 'next_step', 'same_step', 'disabled', or an AutoresetMode \(AutoresetMode.NEXT_STEP"),
+    (dict(render_mode="human"), UnknownOptionError, "unknown render_mode 'human'; valid: None, 'rgb_array'"),
     (dict(render_scale=0), ValueError, "render_scale must be an int in 1..64"),
-    (dict(palette="purple"), ValueError, "valid: white, octo, green, amber, blue"),
+    (dict(palette="purple"), UnknownOptionError, "valid: 'white', 'octo', 'green', 'amber', 'blue', or an"),
     (dict(palette=[(0, 0, 0), (0, 0, 300)]), ValueError, "pair of RGB triples"),
     (dict(obs_scale=2), ValueError, "obs_scale must be one of 1, 255, got 2"),
     (dict(frames_per_step=0), ValueError, "frames_per_step must be an int >= 1"),
@@ -34,7 +36,7 @@ def envs(counter_rom):
     (dict(max_episode_steps=0), ValueError, "max_episode_steps must be an int >= 1"),
     (dict(repeat_action_probability=1.5), ValueError, r"repeat_action_probability must be a number in \[0, 1\]"),
     (dict(noop_max=-1), ValueError, "noop_max must be an int >= 0"),
-    (dict(device="quantum"), ValueError, "unknown or unavailable device 'quantum'; available: cpu:0"),
+    (dict(device="quantum"), UnknownOptionError, "unknown or unavailable device 'quantum'; valid: 'cpu:0'"),
     (dict(frame_skip=4), TypeError, r"unknown keyword\(s\) \['frame_skip'\]; valid: autoreset_mode"),
 ])
 def test_bad_vector_env_arguments(counter_rom, kwargs, error, message):
@@ -44,7 +46,9 @@ def test_bad_vector_env_arguments(counter_rom, kwargs, error, message):
 
 
 def test_unknown_game_lists_the_valid_ids():
-    with pytest.raises(KeyError, match="Pong"):
+    with pytest.raises(KeyError, match="Pong"):  # what the core registry raised before the resolver
+        OctaxVectorEnv("Pongg", 2)
+    with pytest.raises(UnknownOptionError, match=r"unknown game 'Pongg' \(did you mean 'Pong'\?\); valid: 'Airplane'"):
         OctaxVectorEnv("Pongg", 2)
     with pytest.raises(gym.error.Error):
         gym.make("octax/Pongg-v0")
@@ -56,13 +60,13 @@ def test_single_env_refuses_vector_only_and_unknown_keywords(counter_rom):
 
 
 @pytest.mark.parametrize("actions, error, message", [
-    (np.array([0, 1, 3]), ValueError, r"action 3 is out of range; valid actions are 0..2"),
-    (np.array([0, -1, 1]), ValueError, r"action -1 is out of range"),
+    (np.array([0, 1, 3]), InvalidActionError, r"action 3 is out of range; valid actions are 0..2"),
+    (np.array([0, -1, 1]), InvalidActionError, r"action -1 is out of range"),
     (np.array([0, 1]), ValueError, r"actions must have shape \(3,\), one per env, got \(2,\)"),
     (np.zeros((3, 1), np.int64), ValueError, r"must have shape \(3,\)"),
     (np.array([0.0, 1.0, 2.0]), TypeError, "actions must be integers, got float64"),
     (np.array([True, False, True]), TypeError, "actions must be integers, got bool"),
-    ([0, 1, 5], ValueError, "action 5 is out of range"),
+    ([0, 1, 5], InvalidActionError, "action 5 is out of range"),
     (jnp.array([0, 1, 9]), ValueError, "action 9 is out of range"),
     (1, ValueError, r"must have shape \(3,\)"),
 ])
@@ -82,7 +86,7 @@ def test_bad_torch_actions(envs):
 
 
 @pytest.mark.parametrize("action, error, message", [
-    (3, ValueError, r"action 3 is out of range; valid actions are 0..2"),
+    (3, InvalidActionError, r"action 3 is out of range; valid actions are 0..2"),
     (1.0, TypeError, "an action is one integer in 0..2, got float64"),
     (np.array([1]), TypeError, r"got int64 of shape \(1,\)"),
     (True, TypeError, "got bool"),

@@ -17,6 +17,7 @@ import pytest
 
 minari = pytest.importorskip("minari")
 
+from octax_gym import InvalidActionError  # noqa: E402
 from octax_gym.datasets import collect_dataset, episode_seed  # noqa: E402
 
 GAME, ENVS, STEPS, SEED, MAX_STEPS = "Brix", 3, 331, 7, 35  # 331 = 3 * 110 + 1: the last step fills one lane
@@ -179,14 +180,15 @@ def test_overwrite_replaces_a_dataset(datasets_path):
 
 
 @pytest.mark.parametrize("change, message", [
-    ({"env_id": "NoSuchGame"}, r"unknown game 'NoSuchGame'; valid: a game id \(.*Brix"),
+    ({"env_id": "NoSuchGame"}, r"unknown game 'NoSuchGame'; valid: .*'Brix', .*or their Gymnasium ids"),
     ({"num_steps": 0}, r"num_steps must be an int >= 1"),
     ({"num_envs": 0}, r"num_envs must be an int >= 1"),
     ({"seed": -1}, r"seed must be an int in 0\.\."),
     ({"dataset_id": "octax/Brix"}, r"dataset_id must look like 'namespace/name-v0'.*-vN"),
     ({"dataset_id": "octax/Brix v0"}, r"dataset_id must look like"),
     ({"policy": "greedy"}, r"unknown policy 'greedy'; valid: None, 'random', 'noop'"),
-    ({"max_episode_step": 10}, r"unknown env option\(s\) \['max_episode_step'\]; valid: .*max_episode_steps"),
+    ({"max_episode_step": 10}, r"unknown env option\(s\) \['max_episode_step'\] \(did you mean "
+                               r"'max_episode_steps'\?\); valid: .*'max_episode_steps'"),
 ])
 def test_bad_arguments_name_the_valid_choices(change, message, datasets_path):
     arguments = {"env_id": GAME, "dataset_id": "octax/Brix-bad-v0", "num_steps": 6, "num_envs": ENVS,
@@ -196,15 +198,17 @@ def test_bad_arguments_name_the_valid_choices(change, message, datasets_path):
     assert not (datasets_path / "octax" / "Brix-bad-v0").exists()
 
 
-@pytest.mark.parametrize("actions, message", [
-    (lambda n: np.ones((n, 1), np.int64), r"must return 3 integer actions, shape \(3,\), got int64 of shape \(3, 1\)"),
-    (lambda n: np.ones(n - 1, np.int64), r"got int64 of shape \(2,\)"),
-    (lambda n: np.ones(n, np.float32), r"integer actions.*got float32"),
-    (lambda n: np.full(n, 3), r"actions out of range \(3\.\.3\); Brix's actions are 0\.\.2"),
-    (lambda n: np.full(n, -1), r"out of range \(-1\.\.-1\)"),
+@pytest.mark.parametrize("actions, error, message", [
+    (lambda n: np.ones((n, 1), np.int64), ValueError,
+     r"Brix, from the policy: actions must have shape \(3,\), one per env, got \(3, 1\)"),
+    (lambda n: np.ones(n - 1, np.int64), ValueError, r"got \(2,\)"),
+    (lambda n: np.ones(n, np.float32), TypeError, r"actions must be integers, got float32"),
+    (lambda n: np.full(n, 3), InvalidActionError,
+     r"Brix, from the policy: action 3 is out of range; valid actions are 0\.\.2"),
+    (lambda n: np.full(n, -1), InvalidActionError, r"action -1 is out of range"),
 ])
-def test_a_policy_returning_bad_actions_fails_and_leaves_no_dataset(actions, message, datasets_path):
-    with pytest.raises(ValueError, match=message):
+def test_a_policy_returning_bad_actions_fails_and_leaves_no_dataset(actions, error, message, datasets_path):
+    with pytest.raises(error, match=message):
         collect_dataset(GAME, "octax/Brix-bad-v0", 6, num_envs=ENVS, policy=lambda obs: actions(len(obs)),
                         progress=False)
     assert not (datasets_path / "octax" / "Brix-bad-v0").exists()

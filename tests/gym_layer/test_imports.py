@@ -39,7 +39,8 @@ def test_the_public_names_stay_where_users_import_them():
 
     for name in ("Machine", "Quirks", "make", "list_games", "get_spec", "snapshot", "poke", "assemble", "disassemble"):
         assert callable(getattr(octax_core, name)), name
-    for name in ("OctaxEnv", "OctaxVectorEnv", "InvalidActionError", "make_sb3_vec_env", "make_torchrl_env"):
+    for name in ("OctaxEnv", "OctaxVectorEnv", "InvalidActionError", "UnknownOptionError", "make_sb3_vec_env",
+                 "make_torchrl_env"):
         assert getattr(octax_gym, name) is not None, name
     assert callable(octax_gym.sb3.make_sb3_vec_env) and callable(octax_gym.torchrl.make_torchrl_env)
     import octax_gym.datasets

@@ -150,7 +150,7 @@ def test_no_normalized_score_without_a_reference(table):
     game_id = next(g for g, row in table.items() if not row.has_reference)
     with pytest.raises(ValueError, match="has no normalized score"):
         scores.normalized_score(game_id, 1.0)
-    with pytest.raises(KeyError, match="no scores for 'NoSuchGame'"):
+    with pytest.raises(KeyError, match="unknown scored game 'NoSuchGame'; valid: 'Airplane'"):
         scores.normalized_score("NoSuchGame", 1.0)
 
 

@@ -18,6 +18,8 @@ import pytest
 
 import octax_gym
 from octax_gym import cli, render, video
+from octax_gym.game_names import resolve_env_id
+from octax_gym.policies import POLICIES
 
 H264_FOURCCS = {"avc1", "h264"}
 SCALE = 2
@@ -200,9 +202,9 @@ def test_record_plays_a_policy_function(videos, single):
     ("Pong", {"policy": "greedy"}, "'random', 'noop'"),
     ("Pong", {"steps": 0}, "steps must be an int >= 1"),
     ("Pong", {"num_envs": 0}, "num_envs must be an int >= 1"),
-    ("Pongg", {}, r"unknown game 'Pongg'; valid: .*Brix, .*Pong, .*octax/Airplane-v0"),
-    ("octax/Pong-v9", {}, "unknown game"),
-    ("Pong", {"palette": "mauve"}, "white, octo, green, amber, blue"),
+    ("Pongg", {}, r"unknown game 'Pongg' \(did you mean 'Pong'\?\); valid: .*'Brix', .*'Pong', .*octax/Airplane-v0"),
+    ("octax/Pong-v9", {}, r"unknown game 'octax/Pong-v9' \(did you mean 'octax/Pong-v0'"),
+    ("Pong", {"palette": "mauve"}, "'white', 'octo', 'green', 'amber', 'blue'"),
 ])
 def test_record_rejects_bad_arguments_naming_the_valid_ones(tmp_path, game, kwargs, match):
     with pytest.raises(ValueError, match=match):
@@ -256,7 +258,7 @@ def test_cli_record_help_lists_every_policy_and_palette(capsys):
         cli.main(["record", "--help"])
     assert exit_info.value.code == 0
     text = " ".join(capsys.readouterr().out.split())
-    for name in [*video.POLICIES, *render.PALETTES]:
+    for name in [*POLICIES, *render.PALETTES]:
         assert name in text
 
 
@@ -298,7 +300,7 @@ def test_gymnasium_record_video_on_a_vector_env(tmp_path):
 
 
 def test_env_ids_are_what_record_accepts():
-    assert all(video.resolve_env_id(gym_id) == gym_id for gym_id in octax_gym.ENV_IDS)
+    assert all(resolve_env_id(gym_id) == gym_id for gym_id in octax_gym.ENV_IDS)
 
 
 def test_gymnasium_record_video_splits_vector_episodes_at_our_autoresets(tmp_path):

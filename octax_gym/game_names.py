@@ -1,0 +1,61 @@
+"""The names a game goes by, and the one resolver from what a user types to a registered game.
+
+A game has a registry id ("Pong", "BlackRainbow" for an archive game) and a Gymnasium id
+("octax/Pong-v0"). Every place that takes a game by name (the envs, `video.record`,
+`collect_dataset`, the `octax-gym` commands) resolves it here, so each accepts the same
+spellings: either id, exactly or in any case. An unknown name raises one error,
+`UnknownOptionError` (a ValueError and a KeyError), naming the close matches and every id.
+"""
+
+from __future__ import annotations
+
+from typing import Union
+
+from octax_core.env.games import GameSpec, get_spec, list_games
+from octax_gym.choices import UnknownOptionError
+
+NAMESPACE = "octax"
+
+
+def env_id(game: Union[str, GameSpec]) -> str:
+    """The Gymnasium id of a registered game id or of a `GameSpec`, e.g. "Pong" -> "octax/Pong-v0"."""
+    spec = game if isinstance(game, GameSpec) else get_spec(game)
+    return f"{NAMESPACE}/{spec.id}-v{spec.version}"
+
+
+def resolve_spec(game: Union[str, GameSpec]) -> GameSpec:
+    """The registered game a name means: its id or Gymnasium id, exact first, then in any case.
+
+    A `GameSpec` is taken as it is (your own game, `register_game`).
+
+    Raises:
+        TypeError: neither a str nor a GameSpec.
+        UnknownOptionError: no game goes by that name; the message lists every id.
+    """
+    if isinstance(game, GameSpec):
+        return game
+    if not isinstance(game, str):
+        raise TypeError(f"game must be a registered id (str) or a GameSpec, got {type(game).__name__}")
+    names = _names()
+    found = names.get(game) or {name.lower(): game_id for name, game_id in names.items()}.get(game.lower())
+    if found is None:
+        games = list_games()
+        also = f"or their Gymnasium ids ({env_id(games[0])}, ...)" if games else ""
+        raise UnknownOptionError("game", game, games, also, near=names)
+    return get_spec(found)
+
+
+def resolve_env_id(game: Union[str, GameSpec]) -> str:
+    """The Gymnasium id of the game a name means: "Pong", "pong" and "octax/Pong-v0" all give
+    "octax/Pong-v0".
+
+    Raises:
+        TypeError, UnknownOptionError: as `resolve_spec`.
+    """
+    return env_id(resolve_spec(game))
+
+
+def _names() -> dict[str, str]:
+    """Every accepted exact name -> the registry id (read per call: games may be registered late)."""
+    games = list_games()
+    return {game: game for game in games} | {env_id(game): game for game in games}

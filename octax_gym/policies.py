@@ -1,0 +1,66 @@
+"""The built-in policies, one table for everything that plays a game by itself.
+
+`video.record`, `collect_dataset` and their commands (`octax-gym record`, `octax-gym dataset
+collect`, and `octax-gym trace`'s --policy choices) all take a policy the same way: None or
+"random" (uniform actions), "noop" (action 0, no key held), or a function of your own, e.g. a
+trained agent. A policy maps the batched observation, (num_envs, frames_per_step, H, W), to one
+action per env, ints in 0..num_actions-1 of shape (num_envs,). The built-in ones ignore the
+observation, and a seeded one gives the same actions for the same seed in every caller.
+"""
+
+from __future__ import annotations
+
+from typing import Any, Callable, Union
+
+import numpy as np
+
+from octax_gym.choices import check_choice
+
+Policy = Union[None, str, Callable[[Any], Any]]
+Act = Callable[[Any], Any]  # the batched observation -> one action per env
+
+DEFAULT = "random"  # what None means
+FUNCTION_HINT = "or a function from a batch of observations to a batch of actions"
+
+
+def _random(num_envs: int, num_actions: int, seed: int) -> Act:
+    generator = np.random.default_rng(seed)
+    return lambda obs: generator.integers(0, num_actions, num_envs)
+
+
+def _noop(num_envs: int, num_actions: int, seed: int) -> Act:
+    actions = np.zeros(num_envs, np.int64)
+    return lambda obs: actions
+
+
+# name -> (num_envs, num_actions, seed) -> policy
+POLICIES: dict[str, Callable[[int, int, int], Act]] = {
+    "random": _random,  # uniform over the actions, from numpy's generator seeded with `seed`
+    "noop": _noop,  # action 0 (no key) in every env
+}
+
+
+def check_policy(policy: Policy) -> Policy:
+    """`policy`, when it is a function, None or a name in `POLICIES`.
+
+    Raises:
+        UnknownOptionError: anything else; the message lists the names.
+    """
+    return policy if callable(policy) else check_choice("policy", policy, (None, *POLICIES), FUNCTION_HINT)
+
+
+def make_policy(policy: Policy, num_envs: int, num_actions: int, seed: int) -> Act:
+    """The function that plays: `policy` itself, or the built-in one it names, for this batch.
+
+    Raises:
+        UnknownOptionError: as `check_policy`.
+    """
+    policy = check_policy(policy)
+    return policy if callable(policy) else POLICIES[policy or DEFAULT](num_envs, num_actions, seed)
+
+
+def policy_name(policy: Policy) -> str:
+    """A name to record with what the policy made: the built-in name or the function's."""
+    if callable(policy):
+        return getattr(policy, "__qualname__", type(policy).__name__)
+    return policy or DEFAULT
