@@ -1,4 +1,5 @@
-"""octax_gym: CHIP-8 games as Gymnasium environments over the batched JAX core (`octax_core`).
+"""octax_gym: CHIP-8, SUPER-CHIP and XO-CHIP games as Gymnasium environments over the batched
+JAX core (`octax_core`).
 
     import gymnasium as gym
     import octax_gym

@@ -42,7 +42,9 @@ from octax_gym.compiled_step import GYM_ENV_OPTIONS, MAX_SEED
 from octax_gym.game_names import resolve_env_id
 from octax_gym.policies import Act, Policy, check_policy, make_policy, policy_name
 
-FLUSH_STEPS = 20_000  # finished episodes are written once they hold this many steps (~160 MB of CHIP-8 frames)
+# Finished episodes are written once they hold this many steps: ~160 MB of 32 x 64 frames (CHIP-8),
+# 4x that of 64 x 128 ones (SUPER-CHIP, XO-CHIP).
+FLUSH_STEPS = 20_000
 INSTALL_HINT = 'pip install "octax-gym[datasets]"'
 
 
@@ -86,7 +88,8 @@ def collect_dataset(env_id: str, dataset_id: str, num_steps: int, *, num_envs: i
         num_envs: lanes stepped together, >= 1.
         policy: None or "random" (uniform actions drawn from `seed`), "noop" (action 0)
             (`octax_gym.policies.POLICIES`), or a function from the batched observation, numpy
-            uint8 (num_envs, frames_per_step, H, W), to one action per lane (ints in 0..n-1, shape (num_envs,)), e.g. a trained agent.
+            uint8 (num_envs, frames_per_step, H, W), to one action per lane (ints in 0..n-1,
+            shape (num_envs,)), e.g. a trained agent.
         seed: the first episode seed, 0 <= seed and seed + num_envs + num_steps <= 2**32.
         overwrite: replace a dataset of that id; otherwise an existing one is an error.
         progress: a tqdm progress bar on stderr.

@@ -37,11 +37,13 @@ INFO_KEYS = ("score", "lives", "episode_step")
 
 
 class OctaxTorchRLEnv(EnvBase):
-    """`num_envs` copies of one CHIP-8 game as a batched TorchRL `EnvBase` (batch_size (num_envs,)).
+    """`num_envs` copies of one game (CHIP-8, SUPER-CHIP or XO-CHIP) as a batched TorchRL
+    `EnvBase` (batch_size (num_envs,)).
 
-    Specs (N = num_envs, F = frames_per_step):
-      observation: "observation" uint8 (N, F, 32, 64) in 0..obs_scale (`Bounded`), the screen
-        after each 60 Hz frame of the step; "score" float32 (N,), "lives" int32 (N,) (-1 where
+    Specs (N = num_envs, F = frames_per_step; H, W = 32, 64 on CHIP-8, 64, 128 on SUPER-CHIP and
+    XO-CHIP):
+      observation: "observation" uint8 (N, F, H, W) in 0..the vector env's observation high
+        (`Bounded`), the screen after each 60 Hz frame of the step; "score" float32 (N,), "lives" int32 (N,) (-1 where
         the game keeps none) and "episode_step" int32 (N,), the Gymnasium env's info.
       action: "action" int64 (N,) in 0..n-1 (`Categorical`); 0 holds no key, i the game's i-th key.
       reward: "reward" float32 (N, 1), the change of the game's score.

@@ -50,10 +50,12 @@ def check_autoreset_mode(mode) -> AutoresetMode:
 
 
 class OctaxVectorEnv(gymnasium.vector.VectorEnv):
-    """`num_envs` copies of one CHIP-8 game, stepped together by one jitted JAX call.
+    """`num_envs` copies of one game (CHIP-8, SUPER-CHIP or XO-CHIP), stepped together by one
+    jitted JAX call.
 
-    Observation: uint8 (num_envs, frames_per_step, 32, 64), the screen after each 60 Hz frame of
-    the step, lit pixels `obs_scale` (1 or 255). Action: int per env in 0..n-1, 0 = no key, i =
+    Observation: uint8 (num_envs, frames_per_step, H, W), the screen after each 60 Hz frame of the
+    step, 32 x 64 on CHIP-8 and 64 x 128 on SUPER-CHIP and XO-CHIP; lit pixels `obs_scale` (1 or
+    255), XO-CHIP's by plane (1, 2, 3, or 85, 170, 255; docs/env.md). Action: int per env in 0..n-1, 0 = no key, i =
     the game's i-th key held for the whole step. Reward: change of the game's score, float32.
     `info`: score, lives (-1 where the game keeps none), episode_step, each with its `_` mask.
 

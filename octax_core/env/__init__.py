@@ -1,4 +1,5 @@
-"""The env API: CHIP-8 games as functional, batched RL environments (Gymnax-style).
+"""The env API: CHIP-8, SUPER-CHIP and XO-CHIP games as functional, batched RL environments
+(Gymnax-style).
 
 `games/` is the registry (one `GameSpec` per game), `romstore` finds and verifies each game's
 ROM, `config` declares the options, `starts` makes the start states (start-up and no-op starts)

@@ -52,7 +52,7 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
 
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
-        prog="octax-gym", description="CHIP-8 games as reinforcement-learning environments.")
+        prog="octax-gym", description="CHIP-8, SUPER-CHIP and XO-CHIP games as reinforcement-learning environments.")
     commands = parser.add_subparsers(title="commands", metavar="COMMAND")
     for module in (games, roms, record, bench, octo, trace, dataset):
         module.add_commands(commands)

@@ -1,4 +1,4 @@
-"""`octax-gym asm` and `octax-gym disasm`: Octo source to a CHIP-8 ROM and back.
+"""`octax-gym asm` and `octax-gym disasm`: Octo source to a ROM (CHIP-8, SUPER-CHIP, XO-CHIP) and back.
 
     octax-gym asm game.8o                  writes game.ch8 beside it
     octax-gym asm game.8o -o build/game.ch8
@@ -20,7 +20,7 @@ from pathlib import Path
 def add_commands(commands: argparse._SubParsersAction) -> None:
     """Adds this module's subcommands to the `octax-gym` parser."""
     asm = commands.add_parser(
-        "asm", help="assemble an Octo program (.8o) into a CHIP-8 ROM (.ch8)",
+        "asm", help="assemble an Octo program (.8o) into a CHIP-8, SUPER-CHIP or XO-CHIP ROM (.ch8)",
         description="Assembles Octo source into the bytes John Earnest's Octo would write, loaded "
                     "at 0x200. On an error, prints its line and column and exits with status 1. "
                     "See docs/octo.md.")

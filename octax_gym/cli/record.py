@@ -32,7 +32,8 @@ def add_commands(commands: argparse._SubParsersAction) -> None:
     record.add_argument("--seed", type=int, default=0, metavar="S",
                         help="seeds the games (env i: S + i) and the random policy")
     record.add_argument("--scale", type=int, metavar="R",
-                        help="pixels per CHIP-8 pixel (default 8: 512 x 256 per game)")
+                        help="pixels per screen pixel (default 8: 512 x 256 per CHIP-8 game, "
+                             "1024 x 512 per SUPER-CHIP or XO-CHIP one)")
     record.add_argument("--palette", metavar="NAME", help="white (default), octo, green, amber or blue")
     record.add_argument("--no-progress", action="store_true", help="no progress bar")
     record.set_defaults(func=_cmd_record)

@@ -1,4 +1,5 @@
-"""Octo, the CHIP-8 assembly language (John Earnest's): an assembler and a disassembler.
+"""Octo, John Earnest's assembly language for CHIP-8, SUPER-CHIP and XO-CHIP: an assembler and a
+disassembler.
 
 `assemble(source) -> bytes` builds a program byte for byte as Octo does; `disassemble(rom) -> str`
 turns a ROM back into Octo source that assembles to the same bytes. See docs/octo.md.

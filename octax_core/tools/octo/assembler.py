@@ -1,4 +1,5 @@
-"""The Octo assembler: Octo source text in, CHIP-8 program bytes out, byte for byte as Octo builds it.
+"""The Octo assembler: Octo source text in, program bytes out (CHIP-8, SUPER-CHIP or XO-CHIP),
+byte for byte as Octo builds it.
 
 Octo (John Earnest's CHIP-8 language) is a one-pass, token-at-a-time assembler, and the bytes it
 emits are part of its definition: `if vX > vY then` is three instructions through vF, a program
