@@ -17,6 +17,14 @@ per second. Each (platform, N) prints exactly one summary line starting with ``B
 
     python benchmarks/platforms.py                      # N = 512, all three, octax on chip8
     python benchmarks/platforms.py --envs 64,512 --platforms schip,xochip --no-octax
+
+`--same-program` measures what a platform costs by itself: one CHIP-8 program run by a chip8, an
+schip and an xochip `Machine` with the same quirks and instructions per frame, the three timed
+alternately in one process, and prints each platform's instructions/s and its ratio to chip8,
+one ``BENCH same_program`` line per (program, N, platform). The programs: Pong (11 ipf, the
+chip8 quirks) and a 15-ipf CHIP-8 game of the archive (`--archive-chip8-game`, its own quirks).
+
+    python benchmarks/platforms.py --same-program --envs 64,512
 """
 
 from __future__ import annotations
@@ -39,6 +47,7 @@ def _packaged_archive() -> Path:
 
     return ARCHIVE_ROM_DIR
 DEFAULT_GAMES = {"schip": "blackrainbow", "xochip": "civiliz8n"}
+SAME_PROGRAM_ARCHIVE_GAME = "carbon8"  # CHIP-8, 15 instructions a frame
 
 
 def main(argv: Optional[list[str]] = None) -> int:
@@ -53,6 +62,10 @@ def main(argv: Optional[list[str]] = None) -> int:
     parser.add_argument("--archive", type=Path, default=None,
                         help="folder with the archive's ROMs and programs.json (default: the package's copy)")
     parser.add_argument("--no-octax", action="store_true", help="skip the octax comparison on chip8")
+    parser.add_argument("--same-program", action="store_true",
+                        help="run one CHIP-8 program on every platform (same quirks and ipf) and report the ratios")
+    parser.add_argument("--archive-chip8-game", default=SAME_PROGRAM_ARCHIVE_GAME,
+                        help=f"the archive's CHIP-8 program for --same-program (default {SAME_PROGRAM_ARCHIVE_GAME})")
     args = parser.parse_args(argv)
     try:
         args.envs = [int(n) for n in args.envs.split(",")]
@@ -66,7 +79,7 @@ def main(argv: Optional[list[str]] = None) -> int:
     args.devices = 1  # octax_side reads it
     args.archive = args.archive or _packaged_archive()
     try:
-        return run(args)
+        return run_same_program(args) if args.same_program else run(args)
     except (BenchError, FileNotFoundError, KeyError) as exc:
         print(f"{parser.prog}: error: {exc}", file=sys.stderr)
         return 1
@@ -138,6 +151,49 @@ def run(args: argparse.Namespace) -> int:
                 "compile_s": round(ours.compile_s, 2), "octax_sps": round(octax_sps) if theirs else None,
                 "ratio": round(sps / octax_sps, 2) if theirs else None, "device": jax.default_backend(),
             }), flush=True)
+    return 0
+
+
+def same_programs(args: argparse.Namespace) -> list[tuple[str, Path, object, int]]:
+    """(name, ROM path, quirks, instructions per frame) of the CHIP-8 programs --same-program runs."""
+    from octax_core.emulator.quirks import quirks_from_octo, resolve_quirks
+
+    manifest = args.archive / "programs.json"
+    entry = json.loads(manifest.read_text()).get(args.archive_chip8_game) if manifest.is_file() else None
+    if entry is None or entry["platform"] != "chip8":
+        raise BenchError(f"{args.archive_chip8_game!r} is not a CHIP-8 program of the archive at {args.archive}")
+    options = entry["options"]
+    return [(CHIP8_GAME, find_rom(CHIP8_GAME, None), resolve_quirks("chip8"), CHIP8_INSTRUCTIONS_PER_FRAME),
+            (args.archive_chip8_game, args.archive / f"{args.archive_chip8_game}.ch8", quirks_from_octo(options),
+             int(options.get("tickrate", 20)))]
+
+
+def run_same_program(args: argparse.Namespace) -> int:
+    """Each program, each N: the platforms timed alternately on the same work."""
+    import jax
+
+    import octax_core
+
+    programs = same_programs(args)
+    print(machine_line(programs[0][1]), flush=True)
+    progress = Progress(0, False)
+    for name, rom, quirks, ipf in programs:
+        for n in args.envs:
+            sides = {platform: prepare(octax_core.Machine(platform, quirks=quirks, instructions_per_frame=ipf), rom, n,
+                                       args) for platform in args.platforms}
+            time_interleaved(sides, args.repeats, progress, f"{name} n={n}")
+            ips = {platform: n * args.steps * side.instructions_per_step / side.best_s for platform, side in sides.items()}
+            base = ips.get("chip8")
+            for platform, side in sides.items():
+                ratio = ips[platform] / base if base else None
+                print(f"{name} n={n} {platform:6s}: {ips[platform] / 1e6:,.2f} M instr/s"
+                      + (f", {ratio:.2f}x chip8" if ratio else "") + f", compile {side.compile_s:.2f} s", flush=True)
+                print(bench_line("same_program", {
+                    "program": name, "n": n, "platform": platform, "steps": args.steps,
+                    "instructions_per_frame": ipf, "ips": round(ips[platform]),
+                    "ratio": round(ratio, 3) if ratio else None, "compile_s": round(side.compile_s, 2),
+                    "load": round(load_average(), 2), "device": jax.default_backend(),
+                }), flush=True)
     return 0
 
 

@@ -2,9 +2,11 @@
 
 Layered bottom-up: `rom` (program images), `platforms` (the three machines' shapes), `quirks`
 (behaviour profiles), `state` (the state pytree, boot image, host views), `opcodes` and `decode`
-(the opcode tables), `ops/` (one handler per opcode; `planes` is the 128x64 display), `cpu`
-(fetch, decode, execute, the frame; `cpu_extended` for SUPER-CHIP and XO-CHIP), `keypad` (key
-input), `machine` (`Machine`, the frozen config and its entry points). Nothing here knows about games, envs or Gymnasium.
+(the opcode tables), `ops/` (one handler per opcode; `display` is the packed screen of every
+platform), `gate` (work only some machines of a batch need), `cpu` (the one executor: fetch,
+decode, execute, for all three platforms), `idle` (exact idle skipping's cycle detector),
+`frame` (the one frame loop), `keypad` (key input), `machine` (`Machine`, the frozen config and
+its entry points). Nothing here knows about games, envs or Gymnasium.
 See docs/machine.md.
 """
 

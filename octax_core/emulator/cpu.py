@@ -1,10 +1,16 @@
-"""Fetch, decode, execute: one instruction as a pure function of the state.
+"""Fetch, decode, execute: one instruction of any platform as a pure function of the state.
+
+One executor for CHIP-8, SUPER-CHIP and XO-CHIP: what differs is data of the `Platform` (the
+opcodes decoded, the bytes fetched, where addresses wrap, the mirrored bytes, the planes and
+their grid), read here at trace time, so a CHIP-8 machine traces to CHIP-8's program alone.
 
 Every handler runs on every instruction (under `vmap` there is no real branching), so handlers
 return small effects and `execute` merges them field by field with scalar selects on the decoded
 kind, then applies the merged effect once. Whatever the opcode, an instruction costs two
-contiguous memory reads (opcode, 16 bytes at I), one 16-byte window write (two, to keep the
-mirror), one sprite read and XOR, and a few lane selects on the registers and the stack.
+contiguous memory reads (the opcode, 16 bytes at I), one 16-byte window write (two, to keep the
+mirror), a sprite drawn on the 64x32 surface, and a few lane selects on the registers and the
+stack. The work few machines need on a given instruction (a hires sprite, a hires clear, a
+scroll) runs under `gate.when_any`: the whole batch skips it when no machine needs it.
 """
 
 from __future__ import annotations
@@ -13,12 +19,15 @@ from typing import NamedTuple
 
 import jax
 import jax.numpy as jnp
+import numpy as np
 
-from octax_core.emulator.decode import Decoded, Kind, decode
-from octax_core.emulator.ops import Context, Effect, alu, display, flow, keys, memory, timers
+from octax_core.emulator.decode import Decoded, decode
+from octax_core.emulator.gate import when_any
+from octax_core.emulator.opcodes import LEVELS, OPCODES, Kind
+from octax_core.emulator.ops import Context, Effect, alu, display, extended, flow, keys, memory, timers
+from octax_core.emulator.platforms import Platform
 from octax_core.emulator.quirks import Quirks
-from octax_core.emulator.rom import MEMORY_SIZE
-from octax_core.emulator.state import MEMORY_OFFSET, MachineState
+from octax_core.emulator.state import MEMORY_OFFSET, SCREEN_HEIGHT, Extension, MachineState
 
 HANDLERS = {
     Kind.STALL: flow.op_stall,
@@ -44,7 +53,6 @@ HANDLERS = {
     Kind.LD_I: memory.op_annn,
     Kind.JP_V: flow.op_bnnn,
     Kind.RND: alu.op_cxnn,
-    Kind.DRW: display.op_dxyn,
     Kind.SKP: keys.op_ex9e,
     Kind.SKNP: keys.op_exa1,
     Kind.LD_VX_DT: timers.op_fx07,
@@ -56,7 +64,34 @@ HANDLERS = {
     Kind.BCD: memory.op_fx33,
     Kind.STORE: memory.op_fx55,
     Kind.LOAD: memory.op_fx65,
-}  # Kind.NOP has no handler: every field keeps its default
+    # SUPER-CHIP
+    Kind.SCROLL_DOWN: extended.op_00cn,
+    Kind.SCROLL_RIGHT: extended.op_00fb,
+    Kind.SCROLL_LEFT: extended.op_00fc,
+    Kind.EXIT: extended.op_00fd,
+    Kind.LORES: extended.op_00fe,
+    Kind.HIRES: extended.op_00ff,
+    Kind.LD_BIG_FONT: extended.op_fx30,
+    Kind.SAVE_FLAGS: extended.op_fx75,
+    Kind.LOAD_FLAGS: extended.op_fx85,
+    # XO-CHIP
+    Kind.SCROLL_UP: extended.op_00dn,
+    Kind.SAVE_RANGE: extended.op_5xy2,
+    Kind.LOAD_RANGE: extended.op_5xy3,
+    Kind.LD_I_LONG: extended.op_f000,
+    Kind.PLANE: extended.op_fn01,
+    Kind.AUDIO: extended.op_f002,
+    Kind.PITCH: extended.op_fx3a,
+}  # Kind.NOP has no handler: every field keeps its default; DXYN's is added per instruction,
+#    once its collision is known (`display.op_dxyn`)
+
+_KIND_LEVEL = {row.kind: LEVELS[row.platform] for row in OPCODES if row.kind is not None}
+
+
+def handlers(platform: Platform) -> dict:
+    """The handlers of the kinds `platform`'s decoder can produce (DXYN's excepted)."""
+    return {kind: handler for kind, handler in HANDLERS.items() if _KIND_LEVEL.get(kind, 0) <= platform.level}
+
 
 class Fetched(NamedTuple):
     """The instruction at pc, decoded, and the context its handler reads."""
@@ -66,43 +101,57 @@ class Fetched(NamedTuple):
     context: Context
 
 
-def fetch(quirks: Quirks, state: MachineState, keys: jax.Array, stalled=None) -> Fetched:
-    """Reads the opcode at pc and the 16 bytes at I, decodes, and builds the handlers' context.
+def fetch(platform: Platform, quirks: Quirks, state: MachineState, keys, stalled=None) -> Fetched:
+    """Reads the opcode at pc (and on XO-CHIP the word after it) and the 16 bytes at I, decodes,
+    and builds the handlers' context.
 
     Both reads are contiguous slices thanks to the RAM mirror (`state.MEMORY_OFFSET`): the
-    window at I serves FX65's loads and the read half of FX33/FX55's read-modify-write.
+    window at I serves FX65's loads, CHIP-8's sprites and the read half of FX33/FX55's
+    read-modify-write.
     """
     pc, I = state.pc.astype(jnp.int32), state.I.astype(jnp.int32)
-    opcode = jax.lax.dynamic_slice(state.memory, (pc + MEMORY_OFFSET,), (2,)).astype(jnp.int32)
+    code = jax.lax.dynamic_slice(state.memory, (pc + MEMORY_OFFSET,), (platform.fetch_bytes,)).astype(jnp.int32)
     window = jax.lax.dynamic_slice(state.memory, (I + MEMORY_OFFSET,), (16,)).astype(jnp.int32)
-    fields = decode(opcode[0], opcode[1])
+    fields = decode(code[0], code[1], platform)
     kind = fields.kind if stalled is None else jnp.where(stalled, int(Kind.STALL), fields.kind)
-    return Fetched(fields, kind, context(quirks, state, fields, pc, I, window, keys))
-
-
-def context(quirks: Quirks, state: MachineState, fields: Decoded, pc, I, window, keys) -> Context:
-    """The handlers' context of every platform: the decoded fields and the registers, as int32."""
     V, sp = state.V.astype(jnp.int32), state.sp.astype(jnp.int32)
-    return Context(
+    context = Context(
         quirks=quirks, x=fields.x, y=fields.y, n=fields.n, nn=fields.nn, nnn=fields.nnn, vx=V[fields.x],
         vy=V[fields.y], v0=V[0], pc=pc, I=I, sp=sp, stack_top=state.stack[(sp - 1) & 0xF].astype(jnp.int32),
         V=V, window=window, collision=jnp.bool_(False), keys=keys,
         delay_timer=state.delay_timer.astype(jnp.int32), rng=state.rng, key_wait=state.key_wait.astype(jnp.int32),
+        plane=jnp.int32(1),
     )
+    if platform.fetch_bytes == 4:  # a skip jumps over a whole instruction: 4 bytes when it is F000 NNNN
+        next_word = (code[2] << 8) | code[3]
+        context = context._replace(skip_bytes=jnp.where(next_word == 0xF000, 4, 2), next_word=next_word)
+    if state.extension is not None:
+        ext = state.extension
+        context = context._replace(hires=ext.hires, flags=ext.flags.astype(jnp.int32),
+                                   plane=ext.plane.astype(jnp.int32))
+    return Fetched(fields, kind, context)
 
 
 def merge(kind, effects: dict, defaults: Effect) -> Effect:
     """One effect: each field the value of the handler `kind` selects, where that handler sets
-    it, else the field of `defaults`. A chain of scalar selects per field, no branching."""
+    it, else the field of `defaults`. No branching: a scalar field is a chain of scalar selects;
+    a vector field (16 registers or bytes) one lookup in the stack of its candidates, since a
+    chain of whole-vector selects costs 16 times as much per link."""
     merged = {}
     for field, default in zip(Effect._fields, defaults):
         if default is None:  # a field this platform does not have (SUPER-CHIP's, on CHIP-8)
             merged[field] = None
             continue
-        value = default
-        for handler_kind, effect in effects.items():
-            if getattr(effect, field) is not None:
-                value = jnp.where(kind == handler_kind, getattr(effect, field), value)
+        setters = [(k, getattr(effect, field)) for k, effect in effects.items() if getattr(effect, field) is not None]
+        if jnp.ndim(default) == 0:
+            value = default
+            for handler_kind, candidate in setters:
+                value = jnp.where(kind == handler_kind, candidate, value)
+        else:
+            row = np.zeros(len(Kind), np.int32)  # kind -> its row in the stack; 0: the default
+            row[[int(k) for k, _ in setters]] = np.arange(1, len(setters) + 1)
+            stack = jnp.stack([default] + [jnp.asarray(candidate, default.dtype) for _, candidate in setters])
+            value = stack[jnp.asarray(row)[kind]]
         merged[field] = value
     return Effect(**merged)
 
@@ -115,121 +164,213 @@ def sets(kind, effects: dict, field: str) -> jax.Array:
 
 def _defaults(state: MachineState, c: Context) -> Effect:
     """What an instruction leaves alone: pc moves on by 2, everything else stays as it is."""
-    return Effect(pc=c.pc + 2, vx=c.vx, vf=jnp.int32(0), i=c.I, sp=c.sp, push=c.pc, mem_data=c.window,
-                  mem_count=jnp.int32(0), load_count=jnp.int32(0), delay_timer=c.delay_timer,
-                  sound_timer=state.sound_timer.astype(jnp.int32), rng=c.rng, key_wait=c.key_wait,
-                  clear=jnp.bool_(False))
+    effect = Effect(pc=c.pc + 2, vx=c.vx, vf=jnp.int32(0), i=c.I, sp=c.sp, push=c.pc, mem_data=c.window,
+                    mem_count=jnp.int32(0), load_count=jnp.int32(0), delay_timer=c.delay_timer,
+                    sound_timer=state.sound_timer.astype(jnp.int32), rng=c.rng, key_wait=c.key_wait,
+                    clear_planes=jnp.int32(0))
+    if state.extension is None:
+        return effect
+    ext = state.extension
+    return effect._replace(
+        v_lanes=jnp.zeros(16, jnp.bool_), v_values=c.V, scroll_x=jnp.int32(0), scroll_y=jnp.int32(0),
+        hires=c.hires, exited=ext.exited, flags=c.flags, plane=c.plane,
+        audio_pattern=ext.audio_pattern.astype(jnp.int32), pitch=ext.pitch.astype(jnp.int32),
+    )
 
 
-def execute(quirks: Quirks, state: MachineState, keys: jax.Array, stalled=None):
+def execute(platform: Platform, quirks: Quirks, state: MachineState, keys: jax.Array, stalled=None):
     """Runs the instruction at pc: fetch and decode, every handler, merge, apply.
 
     Args:
+        platform: the machine (static).
         quirks: the interpreter behaviour (static).
         state: one machine.
         keys: uint32 mask of held keys.
-        stalled: bool; when true the frame is over (display wait) and nothing changes.
+        stalled: bool; when true the frame is over (display wait, 00FD) and nothing changes.
 
     Returns:
         (new state, the int32 `Kind` that ran: STALL while stalled; `idle` reads it to know
         whether the instruction wrote memory or the screen).
     """
-    fetched = fetch(quirks, state, keys, stalled)
+    fetched = fetch(platform, quirks, state, keys, stalled)
     kind, c = fetched.kind, fetched.context
     # The memory write goes first and DXYN, the one handler that reads the collision, after it,
     # taking its sprite from the written memory: DXYN writes no memory, so those are the same
     # bytes, and XLA never has to copy the memory buffer to keep the old version alive.
-    effects = {k: handler(c) for k, handler in HANDLERS.items() if k != Kind.DRW}
+    effects = {k: handler(c) for k, handler in handlers(platform).items()}
     defaults = _defaults(state, c)
-    memory = _write_memory(state.memory, merge(kind, effects, defaults), c)
-    sprite = _sprite_mask(quirks, memory, c, jnp.where(kind == Kind.DRW, fetched.fields.n, 0))
-    effects[Kind.DRW] = display.op_dxyn(c._replace(collision=display.collides(state.screen, sprite)))
-    new_state = _apply(state, kind, effects, merge(kind, effects, defaults), memory, sprite, c)
-    return new_state, kind
+    before_drawing = merge(kind, effects, defaults)  # all but DXYN's VF, which needs the collision
+    written = _write_memory(platform, state.memory, before_drawing, c)
+    # An instruction draws, clears or scrolls, never two of these, so their order is free: the
+    # rare ones first (scrolls, hires clears), each straight on the state's surfaces.
+    screen, grid = _scroll_and_clear_hires(platform, state, before_drawing, c)
+    drawing = kind == Kind.DRW
+    grid, collision, mask = _draw(platform, quirks, screen, grid, written, c, drawing, fetched.fields.n)
+    effects[Kind.DRW] = display.op_dxyn(c._replace(collision=collision))
+    effect = merge(kind, effects, defaults)
+    screen = _draw_lores(platform, screen, mask, effect, c)
+    return _apply(platform, state, kind, effects, effect, written, screen, grid, c), kind
 
 
-def _write_memory(memory, effect: Effect, c: Context):
+def _write_memory(platform: Platform, memory, effect: Effect, c: Context):
     """The merged effect's memory write: its first mem_count bytes at I, the rest unchanged."""
     lanes = jnp.arange(16, dtype=jnp.int32)
-    written = jnp.where(lanes < effect.mem_count, effect.mem_data, c.window)
-    return _write_window(memory, written.astype(jnp.uint8), c.I)
+    written = jnp.where(lanes < effect.mem_count, effect.mem_data, c.window).astype(jnp.uint8)
+    return write_window(platform, memory, written, c.I)
 
 
-def _sprite_mask(quirks: Quirks, memory, c: Context, height):
-    """The XOR mask of the sprite a DXYN draws (all zero for any other instruction: height 0)."""
-    y = c.vy & 31
-    aligned = jax.lax.dynamic_slice(memory, (c.I - y + MEMORY_OFFSET,), (32 if quirks.clipping else 64,))
-    return display.sprite_mask(aligned.astype(jnp.int32), c.vx & 63, y, height, quirks.clipping)
-
-
-def _apply(state: MachineState, kind, effects: dict, effect: Effect, memory, sprite, c: Context) -> MachineState:
-    """The merged effect applied once: registers by lane selects with VF after Vx (a scatter at
-    x would cost more under vmap), the stack push, I, pc, timers, the screen."""
-    lanes = jnp.arange(16, dtype=jnp.int32)
-    V = jnp.where(lanes < effect.load_count, c.window, c.V)
-    V = jnp.where(lanes == c.x, effect.vx, V)
-    V = jnp.where((lanes == 15) & sets(kind, effects, "vf"), effect.vf, V)
-    keep = jnp.where(effect.clear, jnp.uint32(0), jnp.uint32(0xFFFFFFFF))
-    pushing = (lanes == c.sp) & sets(kind, effects, "push")
-    return MachineState(
-        memory=memory,
-        V=V.astype(jnp.uint8),
-        I=(effect.i & 0xFFF).astype(jnp.uint16),
-        pc=(effect.pc & 0xFFF).astype(jnp.uint16),
-        sp=effect.sp.astype(jnp.uint8),
-        stack=jnp.where(pushing, effect.push & 0xFFF, state.stack).astype(jnp.uint16),
-        delay_timer=effect.delay_timer.astype(jnp.uint8),
-        sound_timer=effect.sound_timer.astype(jnp.uint8),
-        screen=(state.screen & keep) ^ sprite,
-        rng=effect.rng,
-        key_wait=effect.key_wait.astype(jnp.uint8),
-    )
-
-
-def _write_window(memory, window, I):
-    """Writes 16 bytes at address I, wrapping at 4 KiB, and keeps the RAM mirror in step.
+def write_window(platform: Platform, memory, window, I):
+    """Writes 16 bytes at address I, wrapping at the memory size, and keeps the mirror in step.
 
     The second write repeats the same bytes one RAM-length away when the window touches the
-    mirrored start of RAM (I < 16) or runs past its end (I > 4080, the wrapped bytes land in
-    RAM 0x000..); otherwise it rewrites the first window in place. Nothing reads memory after
+    mirrored start of RAM (I < `mirrored_bytes`) or runs past its end (the wrapped bytes land
+    in RAM 0x000..); otherwise it rewrites the first window in place. Nothing reads memory after
     these writes, so XLA updates the buffer in place.
     """
+    size = platform.memory_size
     memory = jax.lax.dynamic_update_slice(memory, window, (I + MEMORY_OFFSET,))
-    other = jnp.where(I > MEMORY_SIZE - 16, I - MEMORY_SIZE, jnp.where(I < 16, I + MEMORY_SIZE, I))
+    other = jnp.where(I > size - 16, I - size, jnp.where(I < platform.mirrored_bytes, I + size, I))
     return jax.lax.dynamic_update_slice(memory, window, (other + MEMORY_OFFSET,))
 
 
-def tick_timers(state: MachineState) -> MachineState:
-    """The 60 Hz tick: each nonzero timer drops by one."""
-    def tick(timer):
-        return jnp.where(timer > 0, timer - 1, timer).astype(timer.dtype)
-    return state.replace(delay_timer=tick(state.delay_timer), sound_timer=tick(state.sound_timer))
+def _sprite_data(platform: Platform, memory, c: Context):
+    """The bytes a sprite is drawn from: CHIP-8's (16,) at I (the window), or (planes, 32) after
+    it: plane 1's at I, plane 2's after plane 1's rows when both planes are drawn, else at I too."""
+    if not platform.extended:
+        return c.window
+    first = jax.lax.dynamic_slice(memory, (c.I + MEMORY_OFFSET,), (32,))
+    if platform.planes == 1:
+        return first[None, :].astype(jnp.int32)
+    size = jnp.where(c.n == 0, 32, c.n) * (c.plane & 1)  # plane 1's bytes, when plane 1 is drawn
+    second = jax.lax.dynamic_slice(memory, (c.I + size + MEMORY_OFFSET,), (32,))
+    return jnp.stack([first, second]).astype(jnp.int32)
 
 
-def run_frame(quirks: Quirks, instructions_per_frame: int, state: MachineState, keys,
-              halted=None) -> MachineState:
-    """One 60 Hz frame: up to `instructions_per_frame` instructions, then the timer tick.
+class _Sprite(NamedTuple):
+    """What a hires draw reads (see `_draw_hires`)."""
 
-    `halted` (bool, optional) freezes the machine for the frame: no instruction runs and the
-    timers do not tick, so the state comes back unchanged (the env uses it for ended episodes).
+    patterns: jax.Array  # (planes, 16) uint32, zero on planes not drawn and on machines not in hires
+    x: jax.Array
+    y: jax.Array
+    height: jax.Array
+
+
+def _scroll_and_clear_hires(platform: Platform, state: MachineState, effect: Effect, c: Context):
+    """The (screen, grid) after a scroll of the selected planes (of the 64x32 screen in lores, of
+    the grid in hires) or a hires clear, under `when_any`: most instructions of most batches
+    have neither. CHIP-8 has neither."""
+    if not platform.extended:
+        return state.screen, None
+    planes = jnp.arange(platform.planes, dtype=jnp.int32)
+    cleared = ((effect.clear_planes >> planes) & 1) == 1
+    selected = ((c.plane >> planes) & 1) == 1
+    moving = (effect.scroll_x != 0) | (effect.scroll_y != 0)
+
+    def amounts(mode):  # a scroll moves the surface of the machine's mode; the other one stays
+        return jnp.where(mode, effect.scroll_x, 0), jnp.where(mode, effect.scroll_y, 0)
+
+    grid = when_any(c.hires & ((effect.clear_planes != 0) | moving), _scroll_planes, state.extension.grid,
+                    (cleared & c.hires, selected, *amounts(c.hires)))
+    screen = when_any(~c.hires & moving, _scroll_planes, state.screen,
+                      (jnp.zeros_like(cleared), selected, *amounts(~c.hires)))
+    return screen, grid
+
+
+def _scroll_planes(surface, inputs):
+    """Clears the `cleared` planes of a (planes, rows, words) surface, then scrolls the selected
+    ones by (dx, dy) pixels of that surface. No-op where nothing is cleared and dx = dy = 0."""
+    cleared, selected, dx, dy = inputs
+    surface = jnp.where(cleared[:, None, None], jnp.uint32(0), surface)
+    return jnp.where(selected[:, None, None], display.scroll(surface, dx, dy), surface)
+
+
+class _Sprite(NamedTuple):
+    """What a hires draw reads (see `_draw_hires`)."""
+
+    patterns: jax.Array  # (planes, 16) uint32, zero on planes not drawn and on machines not in hires
+    x: jax.Array
+    y: jax.Array
+    height: jax.Array
+
+
+def _draw(platform: Platform, quirks: Quirks, screen, grid, memory, c: Context, drawing, n):
+    """DXYN: (the grid with the hires sprite drawn, the collision, the XOR mask of the 64x32
+    sprite: all zero for any other instruction, and for a machine in hires).
+
+    The 64x32 surface (CHIP-8's screen; the lores screen of SUPER-CHIP and XO-CHIP) is drawn by
+    every machine (`_draw_lores`, a zero mask where it does not draw); the 128x64 grid only
+    under `when_any`, when some machine of the batch draws in hires.
     """
-    gated = quirks.display_wait or halted is not None
+    patterns, height = display.sprite_patterns(_sprite_data(platform, memory, c), n, platform.wide_sprites)
+    if not platform.extended:
+        mask = display.sprite_mask(patterns, c.vx & 63, c.vy & 31, jnp.where(drawing, height, 0), display.LORES,
+                                   quirks.clipping)
+        return None, display.collides(screen, mask), mask
+    selected = ((c.plane >> jnp.arange(platform.planes, dtype=jnp.int32)) & 1) == 1
+    patterns = jnp.where(selected[:, None] & drawing, patterns, jnp.uint32(0))
+    lores = jnp.where(c.hires, jnp.uint32(0), patterns)
+    mask = display.sprite_mask(lores, c.vx & 63, c.vy & 31, height, display.LORES, quirks.clipping)
+    lores_collision = display.collides(screen, mask)
+    sprite = _Sprite(jnp.where(c.hires, patterns, jnp.uint32(0)), c.vx & 127, c.vy & 63, height)
+    grid, hires_collision = when_any(drawing & c.hires, _draw_hires(quirks.clipping), (grid, jnp.bool_(False)),
+                                     sprite)
+    return grid, jnp.where(c.hires, hires_collision, lores_collision), mask
 
-    def instruction(carry, _):
-        state, frame_over = carry
-        state, kind = execute(quirks, state, keys, frame_over if gated else None)
-        if quirks.display_wait:  # the VIP's DXYN waits for the next vertical blank
-            frame_over = frame_over | (kind == Kind.DRW)
-        return (state, frame_over), None
 
-    # Built from the state so that it is batched / sharded like the state (shard_map, vmap).
-    frame_over = jnp.zeros_like(state.key_wait, dtype=jnp.bool_)
-    if halted is not None:
-        frame_over = frame_over | halted
-    (state, _), _ = jax.lax.scan(instruction, (state, frame_over), None,
-                                 length=instructions_per_frame)
-    ticked = tick_timers(state)
-    if halted is None:
-        return ticked
-    return state.replace(delay_timer=jnp.where(halted, state.delay_timer, ticked.delay_timer),
-                         sound_timer=jnp.where(halted, state.sound_timer, ticked.sound_timer))
+def _draw_hires(clipping: bool):
+    def draw(operands, sprite: _Sprite):
+        grid, _ = operands
+        mask = display.sprite_mask(sprite.patterns, sprite.x, sprite.y, sprite.height, display.HIRES, clipping)
+        return grid ^ mask, display.collides(grid, mask)
+    return draw
+
+
+def _draw_lores(platform: Platform, screen, mask, effect: Effect, c: Context):
+    """The 64x32 screen after the merged effect's clear and sprite: one AND and one XOR, for
+    every machine (a machine in hires keeps all, its mask is 0: its 64x32 screen is dark)."""
+    if not platform.extended:
+        return (screen & jnp.where(effect.clear_planes != 0, jnp.uint32(0), jnp.uint32(0xFFFFFFFF))) ^ mask
+    cleared = ((effect.clear_planes >> jnp.arange(platform.planes, dtype=jnp.int32)) & 1) == 1
+    keep = jnp.where(cleared & ~c.hires, jnp.uint32(0), jnp.uint32(0xFFFFFFFF))[:, None, None]
+    return (screen & keep) ^ mask
+
+
+def _apply(platform: Platform, state: MachineState, kind, effects: dict, effect: Effect, memory, screen, grid,
+           c: Context) -> MachineState:
+    """The merged effect applied once: registers by lane selects with VF after Vx (a scatter at
+    x would cost more under vmap), the stack push, I, pc (wrapped at the memory size), timers,
+    the screen, and the extension's fields."""
+    lanes = jnp.arange(16, dtype=jnp.int32)
+    V = jnp.where(lanes < effect.load_count, c.window, c.V)
+    if effect.v_lanes is not None:
+        V = jnp.where(effect.v_lanes, effect.v_values, V)
+    V = jnp.where(lanes == c.x, effect.vx, V)
+    V = jnp.where((lanes == 15) & sets(kind, effects, "vf"), effect.vf, V)
+    pushing = (lanes == c.sp) & sets(kind, effects, "push")
+    address_mask = platform.address_mask
+    extension = None
+    if state.extension is not None:
+        extension = Extension(hires=effect.hires, grid=grid, flags=effect.flags.astype(jnp.uint8), exited=effect.exited,
+                              plane=effect.plane.astype(jnp.uint8),
+                              audio_pattern=effect.audio_pattern.astype(jnp.uint8), pitch=effect.pitch.astype(jnp.uint8))
+    return MachineState(
+        memory=memory,
+        V=V.astype(jnp.uint8),
+        I=(effect.i & address_mask).astype(jnp.uint16),
+        pc=(effect.pc & address_mask).astype(jnp.uint16),
+        sp=effect.sp.astype(jnp.uint8),
+        stack=jnp.where(pushing, effect.push & address_mask, state.stack).astype(jnp.uint16),
+        delay_timer=effect.delay_timer.astype(jnp.uint8),
+        sound_timer=effect.sound_timer.astype(jnp.uint8),
+        screen=screen,
+        rng=effect.rng,
+        key_wait=effect.key_wait.astype(jnp.uint8),
+        extension=extension,
+    )
+
+
+def tick_timers(state: MachineState, ticking=True) -> MachineState:
+    """The 60 Hz tick where `ticking`: each nonzero timer drops by one."""
+    def tick(timer):
+        return jnp.where(ticking & (timer > 0), timer - 1, timer).astype(timer.dtype)
+    return state.replace(delay_timer=tick(state.delay_timer), sound_timer=tick(state.sound_timer))

@@ -10,13 +10,14 @@ F002, FN01 with N in 0..3), so they read one entry per 16-bit word (`word_table`
 from __future__ import annotations
 
 import functools
-from typing import NamedTuple
+from typing import NamedTuple, Union
 
 import jax
 import jax.numpy as jnp
 import numpy as np
 
 from octax_core.emulator.opcodes import LEVELS, OPCODES, Kind, lookup
+from octax_core.emulator.platforms import PLATFORMS, Platform, resolve_platform
 
 __all__ = ["Decoded", "KIND_TABLE", "Kind", "decode", "word_table"]
 
@@ -61,13 +62,15 @@ class Decoded(NamedTuple):
     nnn: jax.Array
 
 
-def decode(high: jax.Array, low: jax.Array, platform: str = "chip8") -> Decoded:
-    """Splits the two opcode bytes into fields and looks up the instruction kind on `platform`."""
+def decode(high: jax.Array, low: jax.Array, platform: Union[Platform, str] = PLATFORMS["chip8"]) -> Decoded:
+    """Splits the two opcode bytes into fields and looks up the instruction kind on `platform`
+    (a `Platform`, or its name as `Machine` takes it)."""
+    platform = resolve_platform(platform)
     high, low = high.astype(jnp.int32), low.astype(jnp.int32)
     top, x = high >> 4, high & 0xF
-    if platform == "chip8":
+    if platform.level == 0:
         kind = jnp.asarray(KIND_TABLE.reshape(-1))[top * 256 + low].astype(jnp.int32)
         kind = jnp.where((top == 0) & (x != 0), int(Kind.NOP), kind)  # 0NNN machine-code calls
     else:
-        kind = jnp.asarray(word_table(platform))[high * 256 + low].astype(jnp.int32)
+        kind = jnp.asarray(word_table(platform.name))[high * 256 + low].astype(jnp.int32)
     return Decoded(kind=kind, x=x, y=low >> 4, n=low & 0xF, nn=low, nnn=(x << 8) | low)

@@ -15,7 +15,7 @@ from typing import Union
 import jax
 import jax.numpy as jnp
 
-from octax_core.emulator import cpu, cpu_extended, idle
+from octax_core.emulator import cpu, frame, idle
 from octax_core.emulator.keypad import keys_to_mask
 from octax_core.emulator.platforms import Platform, check_program_fits, resolve_platform
 from octax_core.emulator.quirks import Quirks, resolve_quirks
@@ -80,10 +80,8 @@ class Machine:
 
     def execute(self, state: MachineState, keys) -> MachineState:
         """Runs exactly one instruction (no timer tick, no display wait; after 00FD, nothing)."""
-        if self.platform.extended:
-            new_state, _ = cpu_extended.execute(self.platform, self.quirks, state, keys_to_mask(keys), state.exited)
-        else:
-            new_state, _ = cpu.execute(self.quirks, state, keys_to_mask(keys))
+        stalled = None if state.extension is None else state.extension.exited
+        new_state, _ = cpu.execute(self.platform, self.quirks, state, keys_to_mask(keys), stalled)
         return new_state
 
     def run_frames(self, state: MachineState, keys, frames, *, halted=None, record_screens: bool = False):
@@ -97,12 +95,12 @@ class Machine:
                 every count (not with `record_screens`, whose output has `frames` rows).
             halted: optional bool scalar; where true nothing runs, the timers do not tick and
                 the state comes back unchanged (the env halts episodes that have ended).
-            record_screens: also return the packed screen after each frame.
+            record_screens: also return the packed picture after each frame (`state.display`).
 
         Returns:
             The state after the frames; with `record_screens`, `(state, screens)` where screens
             is (frames, 32, 2) uint32 on CHIP-8, (frames, planes, 64, 4) on SUPER-CHIP and
-            XO-CHIP (`octax_core.emulator.state.unpack_screen` unpacks either).
+            XO-CHIP, lores pictures doubled (`octax_core.emulator.state.unpack_screen` unpacks either).
 
         Raises:
             TypeError: `frames` is neither an int nor an integer scalar array, or is an array
@@ -110,38 +108,23 @@ class Machine:
             ValueError: a negative frame count given as an int.
         """
         mask = keys_to_mask(keys)
-        if self.skip_idle and self.instructions_per_frame >= idle.SKIP_FROM:
-            return self._run_frames_skipping(state, mask, frames, halted, record_screens)
-
-        def frame(state):
-            if self.platform.extended:
-                return cpu_extended.run_frame(self.platform, self.quirks, self.instructions_per_frame, state,
-                                              mask, halted)
-            return cpu.run_frame(self.quirks, self.instructions_per_frame, state, mask, halted)
-
-        if isinstance(frames, jax.Array) and not record_screens:
-            _check_traced_frames(frames)
-            return jax.lax.fori_loop(0, frames, lambda _, state: frame(state), state)
-        frames = _check_static_frames(frames, record_screens)
-
-        def body(state, _):
-            state = frame(state)
-            return state, (state.screen if record_screens else None)
-
-        state, screens = jax.lax.scan(body, state, None, length=frames)
-        return (state, screens) if record_screens else state
-
-    def _run_frames_skipping(self, state: MachineState, mask, frames, halted, record_screens: bool):
-        """`run_frames` with idle instructions skipped (`octax_core.emulator.idle`)."""
         halted = jnp.zeros_like(state.pc, dtype=jnp.bool_) if halted is None else jnp.asarray(halted, jnp.bool_)
         if isinstance(frames, jax.Array) and not record_screens:
             _check_traced_frames(frames)
-            one = idle.frame_runner(self.platform, self.quirks, self.instructions_per_frame, 1, False)
+            one = self._runner(1, False)
             return jax.lax.fori_loop(0, frames, lambda _, state: one(state, mask, halted)[0], state)
         frames = _check_static_frames(frames, record_screens)
-        run = idle.frame_runner(self.platform, self.quirks, self.instructions_per_frame, frames, record_screens)
-        state, screens = run(state, mask, halted)
+        state, screens = self._runner(frames, record_screens)(state, mask, halted)
         return (state, screens) if record_screens else state
+
+    @property
+    def skipping(self) -> bool:
+        """Whether idle skipping takes effect: asked for, and at >= `idle.SKIP_FROM` instructions a frame."""
+        return self.skip_idle and self.instructions_per_frame >= idle.SKIP_FROM
+
+    def _runner(self, frames: int, record_screens: bool):
+        return frame.frame_runner(self.platform, self.quirks, self.instructions_per_frame, frames, record_screens,
+                                  self.skipping)
 
 
 def _check_traced_frames(frames: jax.Array) -> None:

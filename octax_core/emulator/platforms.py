@@ -1,10 +1,16 @@
-"""The three machines: CHIP-8, SUPER-CHIP and XO-CHIP, as static config.
+"""The three machines: CHIP-8, SUPER-CHIP and XO-CHIP, as static data for the one CPU.
 
 A platform fixes the instruction set, the memory size and the display; the quirks (how the
 ambiguous instructions behave) are a separate choice, and any platform may run with any quirks.
 Like the quirks, the platform shapes the traced program, so it lives in the frozen `Machine`,
 never in the state. Each platform is a superset of the one before: an opcode introduced by a
 later platform is an unknown opcode (a no-op) on an earlier one.
+
+Everything the executor (`octax_core.emulator.cpu`) does differently per platform is read from
+here: the opcodes it decodes (`level`), how many bytes it fetches (`fetch_bytes`), where
+addresses wrap (`memory_size`), how much of RAM's start is mirrored after it (`mirrored_bytes`),
+the bit planes and their grid (`planes`, `extended`), and whether N = 0 draws a 16x16 sprite.
+CHIP-8 is the smallest case of each.
 """
 
 from __future__ import annotations
@@ -37,6 +43,29 @@ class Platform:
     def extended(self) -> bool:
         """Whether this is SUPER-CHIP or later: the 128x64 display, flags, exit."""
         return self.level > 0
+
+    @property
+    def fetch_bytes(self) -> int:
+        """Bytes read at pc: 4 on XO-CHIP, whose F000 NNNN is 4 bytes long (a skip jumps over
+        all of it, so every instruction looks at the word after it), else the 2 of an opcode."""
+        return 4 if self.level >= 2 else 2
+
+    @property
+    def address_mask(self) -> int:
+        """I, pc and the stack wrap at the memory size: address & address_mask."""
+        return self.memory_size - 1
+
+    @property
+    def mirrored_bytes(self) -> int:
+        """How many bytes of RAM's start are kept again after its end, so that every read at an
+        address (16 at I for CHIP-8's loads and sprites; 64 for SUPER-CHIP's 16x16 sprite on
+        two planes) is one contiguous slice (`state.MEMORY_OFFSET`)."""
+        return 64 if self.extended else 16
+
+    @property
+    def wide_sprites(self) -> bool:
+        """Whether DXY0 draws a 16x16 sprite (SUPER-CHIP and later); on CHIP-8 it draws nothing."""
+        return self.extended
 
     @property
     def max_program_size(self) -> int:

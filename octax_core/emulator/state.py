@@ -2,19 +2,23 @@
 
 Everything a running program can change is here, as arrays with explicit dtypes; nothing that
 configures the machine is (that lives in `Machine`). The screen is packed, 32 rows of two uint32
-words, because a sprite draw is then a shift, an AND and an XOR over a few words. SUPER-CHIP and
-XO-CHIP machines add their own fields (None on a CHIP-8 machine, so that its pytree, and every
-program traced over it, stays what it was) and pack a (planes, 64, 4) uint32 screen.
+words on CHIP-8, because a sprite draw is then a shift, an AND and an XOR over a few words.
+SUPER-CHIP and XO-CHIP machines add one optional part, `Extension` (None on a CHIP-8 machine,
+so that its pytree, and every program traced over it, stays what it was): among its fields the
+128x64 hires grid. Their 64x32 lores picture stays in `screen`, one 64x32 surface per plane, so
+that lores work is CHIP-8's (`ops.display`); `display` gives the picture as it is seen.
 """
 
 from __future__ import annotations
 
 import dataclasses
+from typing import Optional
 
 import jax
 import jax.numpy as jnp
 import numpy as np
 
+from octax_core.emulator.ops.display import upscale
 from octax_core.emulator.platforms import PLATFORMS, Platform
 from octax_core.emulator.rom import MEMORY_SIZE, PROGRAM_ADDRESS, Rom
 
@@ -89,8 +93,30 @@ def stored_memory_size(platform: Platform) -> int:
 
 @jax.tree_util.register_dataclass
 @dataclasses.dataclass(frozen=True)
+class Extension:
+    """What SUPER-CHIP and XO-CHIP add to a machine's state (one machine; batch with leading axes)."""
+
+    hires: jax.Array  # () bool, 128x64 mode (00FF) rather than 64x32 (00FE)
+    grid: jax.Array  # (planes, 64, 4) uint32, the hires picture (all dark in lores, as `screen` is in hires)
+    flags: jax.Array  # (16,) uint8, FX75 / FX85's persistent flag registers
+    exited: jax.Array  # () bool, 00FD ran: the program has ended and the machine stands still
+    plane: jax.Array  # () uint8, FN01's plane mask 0..3 (bit 0 plane 1, bit 1 plane 2); SUPER-CHIP: 1
+    audio_pattern: jax.Array  # (16,) uint8, XO-CHIP's F002 128-bit audio pattern
+    pitch: jax.Array  # () uint8, XO-CHIP's FX3A playback pitch (64 = 4000 Hz)
+
+    def replace(self, **changes) -> "Extension":
+        return dataclasses.replace(self, **changes)
+
+
+# The fields `snapshot` shows per extended platform (SUPER-CHIP has no planes or audio to show).
+EXTENSION_FIELDS = {"schip": ("hires", "flags", "exited"),  # the grid is in `screen`, as seen
+                    "xochip": ("hires", "flags", "exited", "plane", "audio_pattern", "pitch")}
+
+
+@jax.tree_util.register_dataclass
+@dataclasses.dataclass(frozen=True)
 class MachineState:
-    """One CHIP-8 machine's mutable state (add leading axes to batch it)."""
+    """One machine's mutable state, on any platform (add leading axes to batch it)."""
 
     memory: jax.Array  # (4192,) uint8: scratch, RAM, mirror (see MEMORY_OFFSET)
     V: jax.Array  # (16,) uint8, registers V0..VF
@@ -100,17 +126,17 @@ class MachineState:
     stack: jax.Array  # (16,) uint16
     delay_timer: jax.Array  # () uint8
     sound_timer: jax.Array  # () uint8
-    screen: jax.Array  # (32, 2) uint32; row y, word x // 32, bit 31 - x % 32
+    screen: jax.Array  # (32, 2) uint32, the 64x32 picture (row y, word x // 32, bit 31 - x % 32); (planes, 32, 2) after CHIP-8
     rng: jax.Array  # () uint32, xorshift32 state, never 0
     key_wait: jax.Array  # () uint8, FX0A: NO_KEY or the key seen pressed
-    # SUPER-CHIP and XO-CHIP only (None on CHIP-8):
-    hires: jax.Array = None  # () bool, 128x64 mode (00FF) rather than 64x32 (00FE)
-    flags: jax.Array = None  # (16,) uint8, FX75 / FX85's persistent flag registers
-    exited: jax.Array = None  # () bool, 00FD ran: the program has ended and the machine stands still
-    # XO-CHIP only:
-    plane: jax.Array = None  # () uint8, FN01's plane mask 0..3 (bit 0 plane 1, bit 1 plane 2)
-    audio_pattern: jax.Array = None  # (16,) uint8, F002's 128-bit audio pattern
-    pitch: jax.Array = None  # () uint8, FX3A's playback pitch (64 = 4000 Hz)
+    extension: Optional[Extension] = None  # SUPER-CHIP and XO-CHIP only
+
+    @property
+    def exited(self) -> jax.Array:
+        """Whether 00FD has ended the program (always false on CHIP-8, which has no 00FD)."""
+        if self.extension is None:
+            return jnp.zeros_like(self.key_wait, dtype=jnp.bool_)
+        return self.extension.exited
 
     def replace(self, **changes) -> "MachineState":
         return dataclasses.replace(self, **changes)
@@ -135,26 +161,24 @@ def stored_memory(ram, platform: Platform = PLATFORMS["chip8"]):
 
 
 def platform_of(state: "MachineState") -> Platform:
-    """The platform a state belongs to, read from which optional fields it has (static)."""
-    if state.hires is None:
-        return PLATFORMS["chip8"]
-    return PLATFORMS["schip" if state.plane is None else "xochip"]
+    """The platform a state belongs to, for host-side views that get a state alone: each
+    platform's stored memory has its own length (`stored_memory_size`)."""
+    return platform_of_memory(state.memory)
 
 
-def ram_size(memory) -> int:
-    """The RAM size inside a stored memory (leading axes allowed): each platform's stored length
-    is its own (`stored_memory_size`)."""
+def platform_of_memory(memory) -> Platform:
+    """The platform whose stored memory is `memory` (leading axes allowed), from its length."""
     length = memory.shape[-1]
     for platform in PLATFORMS.values():
         if stored_memory_size(platform) == length:
-            return platform.memory_size
+            return platform
     known = ", ".join(f"{stored_memory_size(p)} ({p.name})" for p in PLATFORMS.values())
     raise ValueError(f"a stored memory of {length} bytes belongs to no platform; the lengths are {known}")
 
 
 def ram_view(memory):
     """The RAM inside the stored layout: 4 KiB, or 64 KiB on XO-CHIP."""
-    return memory[..., MEMORY_OFFSET : MEMORY_OFFSET + ram_size(memory)]
+    return memory[..., MEMORY_OFFSET : MEMORY_OFFSET + platform_of_memory(memory).memory_size]
 
 
 def seed_rng(key: jax.Array) -> jax.Array:
@@ -165,14 +189,14 @@ def seed_rng(key: jax.Array) -> jax.Array:
 
 def boot_state(rom: Rom, key: jax.Array, platform: Platform = PLATFORMS["chip8"]) -> MachineState:
     """A freshly powered-on `platform` machine with `rom` loaded; jittable and vmappable over `key`."""
-    extended, xochip = {}, {}
+    extension = None
+    screen = jnp.zeros((SCREEN_HEIGHT, 2), jnp.uint32)
     if platform.extended:
-        screen = jnp.zeros((platform.planes, GRID_HEIGHT, GRID_WIDTH // 32), jnp.uint32)
-        extended = dict(hires=jnp.bool_(False), flags=jnp.zeros(16, jnp.uint8), exited=jnp.bool_(False))
-        if platform.planes > 1:
-            xochip = dict(plane=jnp.uint8(1), audio_pattern=jnp.zeros(16, jnp.uint8), pitch=jnp.uint8(64))
-    else:
-        screen = jnp.zeros((SCREEN_HEIGHT, 2), jnp.uint32)
+        screen = jnp.zeros((platform.planes, SCREEN_HEIGHT, 2), jnp.uint32)
+        grid = jnp.zeros((platform.planes, GRID_HEIGHT, GRID_WIDTH // 32), jnp.uint32)
+        extension = Extension(hires=jnp.bool_(False), grid=grid, flags=jnp.zeros(16, jnp.uint8),
+                              exited=jnp.bool_(False), plane=jnp.uint8(1), audio_pattern=jnp.zeros(16, jnp.uint8),
+                              pitch=jnp.uint8(64))
     return MachineState(
         memory=jnp.asarray(boot_memory(rom, platform)),
         V=jnp.zeros(16, jnp.uint8),
@@ -185,9 +209,26 @@ def boot_state(rom: Rom, key: jax.Array, platform: Platform = PLATFORMS["chip8"]
         screen=screen,
         rng=seed_rng(key),
         key_wait=jnp.uint8(NO_KEY),
-        **extended,
-        **xochip,
+        extension=extension,
     )
+
+
+def display(screen, grid=None, hires=None):
+    """The packed picture a machine shows: CHIP-8's (..., 32, 2) screen as it is; on SUPER-CHIP
+    and XO-CHIP the (..., planes, 64, 4) grid in hires (`hires` true), the (..., planes, 32, 2)
+    lores screen doubled to that size in lores. numpy in, numpy out; jittable."""
+    if grid is None:
+        return screen
+    xp = np if isinstance(grid, np.ndarray) else jnp
+    hires = xp.asarray(hires).reshape(xp.shape(hires) + (1, 1, 1))
+    return xp.where(hires, grid, upscale(screen))
+
+
+def shown(state: MachineState):
+    """`display` of a state: the packed picture it shows."""
+    if state.extension is None:
+        return state.screen
+    return display(state.screen, state.extension.grid, state.extension.hires)
 
 
 def unpack_screen(screen, on=True, dtype=jnp.bool_):
@@ -252,16 +293,22 @@ def snapshot(state: MachineState) -> dict[str, np.ndarray]:
     axes are kept. Meant for tests, debugging and tools; it syncs with the device.
     """
     view = {field.name: np.asarray(getattr(state, field.name)) for field in dataclasses.fields(state)
-            if getattr(state, field.name) is not None}
+            if field.name != "extension"}
+    if state.extension is not None:
+        view.update({name: np.asarray(getattr(state.extension, name))
+                     for name in EXTENSION_FIELDS[platform_of(state).name]})
     view["memory"] = ram_view(view["memory"])
     view["screen"] = screen_pixels(state)
     return view
 
 
 def screen_pixels(state: MachineState) -> np.ndarray:
-    """The screen as numpy bool pixels in `snapshot`'s shape for the state's platform."""
+    """The picture as numpy bool pixels in `snapshot`'s shape for the state's platform."""
     platform = platform_of(state)
-    pixels = np.asarray(unpack_screen(np.asarray(state.screen)))
+    picture = np.asarray(state.screen)
+    if state.extension is not None:
+        picture = display(picture, np.asarray(state.extension.grid), np.asarray(state.extension.hires))
+    pixels = np.asarray(unpack_screen(picture))
     if platform.extended and platform.planes == 1:
         pixels = pixels[..., 0, :, :]
     return pixels

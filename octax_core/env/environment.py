@@ -28,7 +28,7 @@ import jax.numpy as jnp
 import numpy as np
 
 from octax_core.emulator.machine import Machine
-from octax_core.emulator.state import (MachineState, screen_values, screen_values_max, screen_values_shape,
+from octax_core.emulator.state import (MachineState, screen_values, shown, screen_values_max, screen_values_shape,
                                        unpack_screen)
 from octax_core.env import starts
 from octax_core.env.config import EnvConfig, EnvParams, make_config, make_params
@@ -103,7 +103,7 @@ class Env:
         machine = starts.draw(self._starts, key)
         state = EnvState(machine=machine, score=self._score(machine), episode_step=jnp.int32(0),
                          last_action=jnp.int32(0), done=jnp.bool_(False))
-        obs = jnp.broadcast_to(self._observe(machine.screen[None]), self.observation_shape)
+        obs = jnp.broadcast_to(self._observe(shown(machine)[None]), self.observation_shape)
         return obs, state
 
     def step_env(self, key: jax.Array, state: EnvState, action, params: EnvParams):
@@ -123,8 +123,8 @@ class Env:
                                  state.machine, jnp.asarray(self._action_masks)[action], halted=state.done)
         score = self._score(machine)
         terminated = jnp.asarray(self.spec.terminated_fn(machine), jnp.bool_)
-        if machine.exited is not None:  # 00FD: the program has ended, so has the episode
-            terminated = terminated | machine.exited
+        if machine.extension is not None:  # 00FD: the program has ended, so has the episode
+            terminated = terminated | machine.extension.exited
         episode_step = jnp.where(state.done, state.episode_step, state.episode_step + 1)
         truncated = ~terminated & (episode_step >= params.max_episode_steps)
         reward = jnp.where(state.done, 0.0, score - state.score).astype(jnp.float32)

@@ -152,8 +152,7 @@ def state_bytes(state) -> int:
 def test_a_chip8_state_keeps_its_fields_and_size():
     state = octax_core.Machine("chip8").boot(b"\x12\x00", jax.random.key(0))
     assert len(jax.tree.leaves(state)) == 11
-    assert [f.name for f in dataclasses.fields(state) if getattr(state, f.name) is None] == [
-        "hires", "flags", "exited", "plane", "audio_pattern", "pitch"]
+    assert [f.name for f in dataclasses.fields(state) if getattr(state, f.name) is None] == ["extension"]
     assert state.memory.shape == (4192,) and state.screen.shape == (32, 2)
     assert state_bytes(state) == 4192 + 16 + 2 + 2 + 1 + 32 + 1 + 1 + 256 + 4 + 1
 
@@ -161,10 +160,15 @@ def test_a_chip8_state_keeps_its_fields_and_size():
 def test_state_shapes_per_platform():
     schip = octax_core.Machine("schip").boot(b"\x12\x00", jax.random.key(0))
     xochip = octax_core.Machine("xochip").boot(b"\x12\x00", jax.random.key(0))
-    assert schip.memory.shape == (4208,) and schip.screen.shape == (1, 64, 4) and schip.plane is None
-    assert xochip.memory.shape == (65648,) and xochip.screen.shape == (2, 64, 4)
-    assert state_bytes(schip) == 4208 + 16 + 2 + 2 + 1 + 32 + 1 + 1 + 1024 + 4 + 1 + 1 + 16 + 1
-    assert state_bytes(xochip) == 65648 + 16 + 2 + 2 + 1 + 32 + 1 + 1 + 2048 + 4 + 1 + 1 + 16 + 1 + 1 + 16 + 1
+    # the 64x32 lores picture per plane in `screen`, as on CHIP-8; the 128x64 hires grid in the extension
+    assert schip.memory.shape == (4208,) and schip.screen.shape == (1, 32, 2) and schip.extension.grid.shape == (1, 64, 4)
+    assert xochip.memory.shape == (65648,) and xochip.screen.shape == (2, 32, 2) and xochip.extension.grid.shape == (2, 64, 4)
+    # one optional part, the same on both: SUPER-CHIP's plane is always 1, its audio never set
+    assert [f.name for f in dataclasses.fields(schip.extension)] == [
+        "hires", "grid", "flags", "exited", "plane", "audio_pattern", "pitch"]
+    assert int(schip.extension.plane) == 1
+    assert state_bytes(schip) == 4208 + 16 + 2 + 2 + 1 + 32 + 1 + 1 + 256 + 4 + 1 + 1 + 1024 + 16 + 1 + 1 + 16 + 1
+    assert state_bytes(xochip) == 65648 + 16 + 2 + 2 + 1 + 32 + 1 + 1 + 512 + 4 + 1 + 1 + 2048 + 16 + 1 + 1 + 16 + 1
     snap = octax_core.snapshot(xochip)
     assert snap["memory"].shape == (65536,) and snap["screen"].shape == (2, 64, 128)
     assert int(snap["plane"]) == 1 and int(snap["pitch"]) == 64 and snap["audio_pattern"].shape == (16,)

@@ -209,10 +209,28 @@ def test_platforms_prints_one_line_per_platform_with_its_state_bytes(octax_rom_d
     lines = harness.parse_bench_lines(result.stdout, "platforms")
     assert [(line["platform"], line["game"]) for line in lines] == [
         ("chip8", "Pong"), ("schip", "blackrainbow"), ("xochip", "civiliz8n")]
-    assert [int(line["state_bytes"]) for line in lines] == [4508, 5310, 67792]
+    assert [int(line["state_bytes"]) for line in lines] == [4508, 5584, 68304]
     for line in lines:
         assert int(line["ips"]) == pytest.approx(int(line["sps"]) * 4 * int(line["instructions_per_frame"]), rel=0.01)
     assert float(lines[0]["ratio"]) > 0 and lines[1]["ratio"] == "na"
+
+
+def test_platforms_same_program_runs_one_chip8_program_on_every_platform(octax_rom_dir):
+    result = subprocess.run(
+        [sys.executable, "benchmarks/platforms.py", "--same-program", "--envs", "2", "--steps", "2", "--repeats", "1"],
+        capture_output=True, text=True, timeout=300, cwd=REPO, check=False)
+    assert result.returncode == 0, result.stderr
+    lines = harness.parse_bench_lines(result.stdout, "same_program")
+    assert [(line["program"], line["platform"]) for line in lines] == [
+        (program, platform) for program in ("Pong", "carbon8") for platform in ("chip8", "schip", "xochip")]
+    assert [int(line["instructions_per_frame"]) for line in lines] == [11] * 3 + [15] * 3
+    for chip8, *later in (lines[:3], lines[3:]):
+        assert float(chip8["ratio"]) == 1.0
+        for line in later:  # the ratio is the platform's instructions/s over chip8's
+            assert float(line["ratio"]) == pytest.approx(int(line["ips"]) / int(chip8["ips"]), abs=0.002)
+    result = subprocess.run([sys.executable, "benchmarks/platforms.py", "--same-program", "--archive-chip8-game",
+                             "civiliz8n"], capture_output=True, text=True, timeout=300, cwd=REPO, check=False)
+    assert result.returncode == 1 and "'civiliz8n' is not a CHIP-8 program of the archive" in result.stderr
 
 
 def test_platforms_usage_errors(tmp_path):

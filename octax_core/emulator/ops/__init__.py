@@ -38,12 +38,12 @@ class Context(NamedTuple):
     delay_timer: jax.Array
     rng: jax.Array  # uint32
     key_wait: jax.Array
-    # SUPER-CHIP and XO-CHIP only (None on CHIP-8, where no handler reads them):
-    skip_bytes: Optional[jax.Array] = None  # how far a skip jumps: 2, or 4 over XO-CHIP's F000 NNNN
-    next_word: Optional[jax.Array] = None  # the 16 bits after the opcode (F000 NNNN's address)
-    hires: Optional[jax.Array] = None  # bool
-    flags: Optional[jax.Array] = None  # (16,) int32, the flag registers
-    plane: Optional[jax.Array] = None  # the selected planes, 0..3 (SUPER-CHIP: always 1)
+    plane: jax.Array  # the selected planes, 0..3 (CHIP-8 and SUPER-CHIP: always 1)
+    # Where a platform has them (None elsewhere, where no handler reads them):
+    skip_bytes: Optional[jax.Array] = None  # XO-CHIP: how far a skip jumps, 2, or 4 over F000 NNNN
+    next_word: Optional[jax.Array] = None  # XO-CHIP: the 16 bits after the opcode (F000 NNNN's address)
+    hires: Optional[jax.Array] = None  # SUPER-CHIP and later: bool
+    flags: Optional[jax.Array] = None  # SUPER-CHIP and later: (16,) int32, the flag registers
 
 
 class Effect(NamedTuple):
@@ -63,11 +63,10 @@ class Effect(NamedTuple):
     sound_timer: Optional[jax.Array] = None  # new sound timer (default unchanged)
     rng: Optional[jax.Array] = None  # new xorshift32 state (default unchanged)
     key_wait: Optional[jax.Array] = None  # new FX0A progress (default unchanged)
-    clear: Optional[jax.Array] = None  # clear the screen before the sprite (default False)
+    clear_planes: Optional[jax.Array] = None  # plane mask cleared (default 0; CHIP-8's one plane is 1)
     # SUPER-CHIP and XO-CHIP only; their defaults are None on CHIP-8, and `merge` skips them there:
     v_lanes: Optional[jax.Array] = None  # (16,) bool: registers loaded from v_values (default none)
     v_values: Optional[jax.Array] = None  # (16,) values for the v_lanes (written before vx and vf)
-    clear_planes: Optional[jax.Array] = None  # plane mask cleared before the sprite (default 0)
     scroll_x: Optional[jax.Array] = None  # scroll the selected planes right by this many pixels
     scroll_y: Optional[jax.Array] = None  # ... and down by this many (screen pixels; default 0)
     hires: Optional[jax.Array] = None  # new display mode (default unchanged)

@@ -2,8 +2,9 @@
 XO-CHIP's long I, register ranges, planes and audio.
 
 Handlers only describe what changes; the screen work (clearing planes, scrolling them, drawing a
-sprite on the 128x64 grid) happens once per instruction in `octax_core.emulator.cpu_extended`,
-driven by the merged `clear_planes`, `scroll_x`, `scroll_y` and the decoded kind.
+sprite) happens once per instruction in `octax_core.emulator.cpu`, driven by the merged
+`clear_planes`, `scroll_x`, `scroll_y` and the decoded kind. CLS and DXYN, which every platform
+has, are in `display`.
 """
 
 from __future__ import annotations
@@ -11,14 +12,8 @@ from __future__ import annotations
 import jax.numpy as jnp
 
 from octax_core.emulator.ops import Context, Effect
+from octax_core.emulator.ops.display import ALL_PLANES
 from octax_core.emulator.state import BIG_FONT_ADDRESS
-
-ALL_PLANES = 3
-
-
-def op_00e0(c: Context) -> Effect:
-    """CLS: clear the selected planes (every plane on SUPER-CHIP)."""
-    return Effect(clear_planes=c.plane)
 
 
 def op_00cn(c: Context) -> Effect:
@@ -54,11 +49,6 @@ def op_00fe(c: Context) -> Effect:
 def op_00ff(c: Context) -> Effect:
     """HIGH: 128x64 mode; every plane is cleared."""
     return Effect(hires=jnp.bool_(True), clear_planes=jnp.int32(ALL_PLANES))
-
-
-def op_dxyn(c: Context) -> Effect:
-    """DRW Vx, Vy, n (n = 0: 16x16); VF = 1 if any lit pixel of any plane was erased."""
-    return Effect(vf=c.collision.astype(jnp.int32))
 
 
 def op_fx30(c: Context) -> Effect:

@@ -1,0 +1,69 @@
+"""`when_any`: work that only a few machines of a batch need, skipped when none of them does.
+
+Under `vmap` there is no branching: a `lax.cond` on a per-machine predicate becomes a select, and
+every machine pays for both branches on every instruction. Most of an instruction's expensive
+work is needed by few machines at a time (a hires sprite, a scroll, a memory write), so the
+batch asks once, "does any machine need it?", and runs the work for the whole batch, or not at
+all. `jax.custom_batching.custom_vmap` gives `when_any` that batched shape; one machine alone
+gets a plain `lax.cond`.
+
+The contract that keeps it exact: `fn(operands)` must give back `operands` unchanged, bit for
+bit, on a machine whose predicate is false. Then running it for the whole batch, or skipping
+it, changes nothing for any machine, and no select over the (large) operands is needed.
+"""
+
+from __future__ import annotations
+
+from typing import Callable, TypeVar
+
+import jax
+import jax.numpy as jnp
+
+T = TypeVar("T")
+
+
+def when_any(pred: jax.Array, fn: Callable[[T, object], T], operands: T, inputs=()) -> T:
+    """`fn(operands, inputs)` when `pred` holds for any machine of the batch, else `operands`.
+
+    Args:
+        pred: bool scalar for one machine (a batch of them under `vmap`).
+        fn: one machine's work; a no-op (bit for bit) on a machine whose `pred` is false. It
+            must read nothing but its arguments (no closed-over traced values).
+        operands: a pytree, returned with the same structure, shapes and dtypes.
+        inputs: a pytree `fn` reads and does not return.
+    """
+
+    @jax.custom_batching.custom_vmap
+    def gated(pred, operands, inputs):
+        return _at_most_once(pred, fn, operands, inputs)
+
+    @gated.def_vmap
+    def gated_batched(axis_size, in_batched, pred, operands, inputs):
+        pred_batched, operands_batched, inputs_batched = in_batched
+        operands, inputs = (_batch(tree, batched, axis_size)
+                            for tree, batched in ((operands, operands_batched), (inputs, inputs_batched)))
+        anyone = jnp.any(pred) if pred_batched else pred
+        out = _at_most_once(anyone, jax.vmap(fn), operands, inputs)
+        return out, jax.tree.map(lambda _: True, out)
+
+    return gated(pred, operands, inputs)
+
+
+def _at_most_once(pred, fn, operands, inputs):
+    """`fn(operands, inputs)` if `pred`, else `operands`, as a loop that runs zero times or once.
+
+    Not a `lax.cond`: XLA:CPU copies a conditional's operands that its skipping branch hands
+    straight back (a whole screen per instruction, measured), where a loop's carry is updated
+    in place, and when the loop does not run, nothing is copied or computed."""
+    def body(carry):
+        _, operands = carry
+        return jnp.bool_(False), fn(operands, inputs)
+
+    _, out = jax.lax.while_loop(lambda carry: carry[0], body, (jnp.asarray(pred, jnp.bool_), operands))
+    return out
+
+
+def _batch(tree, batched, axis_size: int):
+    """Gives every unbatched leaf of `tree` a leading axis of `axis_size`."""
+    return jax.tree.map(lambda leaf, b: leaf if b else jnp.broadcast_to(leaf, (axis_size, *jnp.shape(leaf))),
+                        tree, batched)

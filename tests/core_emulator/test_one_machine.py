@@ -1,0 +1,153 @@
+"""One machine for three platforms: the gated work (`gate.when_any`), the two display surfaces,
+and a CHIP-8 program run alike by the chip8, schip and xochip machines."""
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+import pytest
+
+import octax_core
+from octax_core.emulator import cpu, frame
+from octax_core.emulator.gate import when_any
+from octax_core.emulator.ops import display
+from octax_core.emulator.state import shown
+
+
+def _add_where(operands, inputs):
+    """A gated function: adds `inputs[1]` where `inputs[0]`, else leaves the operand as it is."""
+    on, amount = inputs
+    return jnp.where(on, operands + amount, operands)
+
+
+@pytest.fixture(scope="module")
+def gated():
+    return jax.jit(jax.vmap(lambda pred, x, amount: when_any(pred, _add_where, x, (pred, amount))))
+
+
+def test_when_any_runs_the_work_for_the_machines_that_need_it(gated):
+    x = jnp.arange(6, dtype=jnp.int32) * 10
+    pred = jnp.array([False, True, False, False, True, False])
+    out = gated(pred, x, jnp.full(6, 7, jnp.int32))
+    np.testing.assert_array_equal(out, np.where(pred, x + 7, x))
+    none = gated(jnp.zeros(6, bool), x, jnp.full(6, 7, jnp.int32))
+    np.testing.assert_array_equal(none, x)
+
+
+def test_when_any_skips_the_work_when_no_machine_needs_it():
+    """With no machine asking, `fn` does not run at all: a work that would change every machine
+    (breaking the contract on purpose) shows whether it ran."""
+    def everyone(operands, inputs):
+        return operands + 1
+
+    run = jax.jit(jax.vmap(lambda pred, x: when_any(pred, everyone, x)))
+    x = jnp.zeros(4, jnp.int32)
+    np.testing.assert_array_equal(run(jnp.zeros(4, bool), x), [0, 0, 0, 0])
+    np.testing.assert_array_equal(run(jnp.array([False, True, False, False]), x), [1, 1, 1, 1])
+
+
+def test_when_any_unbatched_and_nested():
+    one = jax.jit(lambda pred, x: when_any(pred, _add_where, x, (pred, jnp.int32(5))))
+    assert int(one(True, jnp.int32(1))) == 6 and int(one(False, jnp.int32(1))) == 1
+    nested = jax.jit(jax.vmap(jax.vmap(lambda pred, x: when_any(pred, _add_where, x, (pred, jnp.int32(5))))))
+    pred = jnp.array([[True, False], [False, False]])
+    np.testing.assert_array_equal(nested(pred, jnp.ones((2, 2), jnp.int32)), [[6, 1], [1, 1]])
+    # an unbatched predicate over a batch: the whole batch, or nobody
+    shared = jax.jit(jax.vmap(lambda x, pred: when_any(pred, _add_where, x, (pred, jnp.int32(5))), in_axes=(0, None)))
+    np.testing.assert_array_equal(shared(jnp.ones(3, jnp.int32), True), [6, 6, 6])
+
+
+def test_upscale_doubles_every_pixel():
+    lores = np.zeros((32, 2), np.uint32)
+    lores[3, 0] = 1 << 31  # pixel (0, 3)
+    lores[31, 1] = 1  # pixel (63, 31)
+    grid = np.asarray(octax_core.emulator.state.unpack_screen(display.upscale(lores)))
+    assert grid.shape == (64, 128)
+    assert set(zip(*np.nonzero(grid))) == {(6, 0), (6, 1), (7, 0), (7, 1), (62, 126), (62, 127), (63, 126), (63, 127)}
+    np.testing.assert_array_equal(np.asarray(display.upscale(jnp.asarray(lores))), display.upscale(lores))
+
+
+@pytest.mark.parametrize("clipping", [True, False])
+def test_a_sprite_on_both_surfaces_is_the_same_picture(clipping):
+    """The 64x32 surface with its pixels doubled is the 128x64 grid drawn with doubled sprite
+    rows at doubled coordinates: the two surfaces agree, edges and wrap included."""
+    rng = np.random.default_rng(0)
+    for _ in range(20):
+        patterns = jnp.asarray(rng.integers(0, 1 << 16, 16, dtype=np.uint32) << 16)
+        x, y, height = (jnp.int32(v) for v in (rng.integers(0, 64), rng.integers(0, 32), rng.integers(0, 17)))
+        lores = display.sprite_mask(patterns, x, y, height, display.LORES, clipping)
+        doubled_rows = jnp.repeat(display.double_bits(patterns >> 16), 2)  # 32 grid rows of 32 bits
+        tiled = jnp.concatenate([doubled_rows, jnp.zeros(32, jnp.uint32)])
+        words = display.place(tiled, 2 * x, 4, clipping)  # (64, 4): grid rows of the sprite's frame
+        rows = np.asarray(words)
+        grid = np.zeros((64, 4), np.uint32)
+        for r in range(2 * int(height)):
+            target = 2 * int(y) + r
+            if target >= 64 and clipping:
+                continue
+            grid[target % 64] |= rows[r]
+        np.testing.assert_array_equal(display.upscale(np.asarray(lores)), grid)
+
+
+PONG = "Pong (1 player).ch8"
+
+
+@pytest.fixture(scope="module")
+def pong_runs(octax_rom_dir):
+    """Pong, 11 instructions a frame, the chip8 quirks, 8 machines with random keys, 300 frames,
+    on each platform: (state, recorded pictures) by platform name."""
+    rom = (octax_rom_dir / PONG).read_bytes()
+    keys = jax.random.randint(jax.random.key(1), (8,), 0, 1 << 16).astype(jnp.uint32) & 0x1012
+    out = {}
+    for platform in ("chip8", "schip", "xochip"):
+        machine = octax_core.Machine(platform, quirks="chip8", instructions_per_frame=11)
+        boot = jax.vmap(lambda k: machine.boot(rom, k))(jax.random.split(jax.random.key(0), 8))
+        run = jax.jit(jax.vmap(lambda s, k: machine.run_frames(s, k, 300, record_screens=True)))
+        out[platform] = run(boot, keys)
+    return out
+
+
+def test_one_chip8_program_runs_alike_on_every_platform(pong_runs):
+    """A CHIP-8 program that uses no later opcode plays the same on the later machines: the same
+    registers, RAM and timers, and the same picture, doubled, in every recorded frame."""
+    chip8_state, chip8_screens = pong_runs["chip8"]
+    assert np.asarray(chip8_screens).any()
+    for platform in ("schip", "xochip"):
+        state, screens = pong_runs[platform]
+        for field in ("V", "I", "pc", "sp", "stack", "delay_timer", "sound_timer", "rng", "key_wait"):
+            np.testing.assert_array_equal(getattr(state, field), getattr(chip8_state, field), err_msg=field)
+        ram = np.array(octax_core.emulator.state.ram_view(np.asarray(state.memory))[..., :4096])
+        chip8_ram = octax_core.emulator.state.ram_view(np.asarray(chip8_state.memory))
+        big_font = slice(0xA0, 0xA0 + 160)  # the later platforms' big digits, where CHIP-8 has zeros
+        ram[..., big_font] = 0
+        np.testing.assert_array_equal(ram, chip8_ram)
+        expected = display.upscale(np.asarray(chip8_screens))  # (8, 300, 64, 4)
+        np.testing.assert_array_equal(np.asarray(screens)[:, :, 0], expected, err_msg=platform)
+        if platform == "xochip":
+            assert not np.asarray(screens)[:, :, 1].any()  # plane 2 never drawn
+        assert not np.asarray(state.extension.grid).any() and not np.asarray(state.extension.hires).any()
+
+
+def test_the_frame_loop_is_the_only_loop():
+    """Every path of `Machine.run_frames` goes through `frame.frame_runner` (skipping or not,
+    recording or not); the executor is `cpu.execute` for every platform."""
+    frame.frame_runner.cache_clear()
+    for platform in ("chip8", "schip", "xochip"):
+        for ipf, skip in ((11, True), (40, True), (40, False)):
+            machine = octax_core.Machine(platform, instructions_per_frame=ipf, skip_idle=skip)
+            state = machine.boot(b"\x12\x00", jax.random.key(0))
+            jax.eval_shape(lambda s: machine.run_frames(s, 0, 2, record_screens=True), state)
+            jax.eval_shape(lambda s: machine.run_frames(s, 0, jnp.int32(2)), state)
+    runners = frame.frame_runner.cache_info().currsize
+    assert runners == 3 * 3 * 2  # per platform and config: the recording loop and the one-frame loop
+    assert not hasattr(octax_core.emulator, "cpu_extended")
+    assert cpu.handlers(octax_core.PLATFORMS["chip8"]).keys() < cpu.handlers(octax_core.PLATFORMS["xochip"]).keys()
+
+
+def test_shown_is_the_picture_of_the_mode():
+    machine = octax_core.Machine("schip", instructions_per_frame=20)
+    # hires; draw the 8x1 sprite 0xFF at (0, 0); loop
+    program = bytes([0x00, 0xFF, 0xA2, 0x08, 0xD0, 0x01, 0x12, 0x06, 0xFF])
+    state = machine.run_frames(machine.boot(program, jax.random.key(0)), 0, 1)
+    assert bool(state.extension.hires) and not np.asarray(state.screen).any()
+    np.testing.assert_array_equal(np.asarray(shown(state)), np.asarray(state.extension.grid))
+    assert octax_core.render_text(state).splitlines()[0][:9] == "########."
