@@ -22,7 +22,7 @@ from gymnasium import spaces
 from gymnasium.vector import AutoresetMode
 
 from octax_gym import action_check, backends, compiled_step, render
-from octax_core.emulator.state import screen_values
+from octax_core.emulator.state import screen_values, shown
 from octax_core.env.config import check_option_names
 from octax_core.validate import check_int
 from octax_gym.choices import UnknownOptionError, check_choice, check_names
@@ -182,7 +182,7 @@ class OctaxVectorEnv(gymnasium.vector.VectorEnv):
             return None
         if self._state is None:
             raise gymnasium.error.ResetNeeded("call reset() before render()")
-        pixels = screen_values(np.asarray(self._state.machine.screen), self.core_env.machine.platform)
+        pixels = screen_values(np.asarray(shown(self._state.machine)), self.core_env.machine.platform)
         return tuple(render.to_rgb(p, self.render_scale, self.palette) for p in pixels)
 
     def close_extras(self, **kwargs):

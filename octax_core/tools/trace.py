@@ -24,6 +24,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
+from octax_core.emulator.state import shown
 from octax_core.env.environment import Env, EnvParams, make
 from octax_core.env.games import GameSpec, get_spec
 from octax_core.validate import check_int
@@ -195,4 +196,4 @@ def _unchanged(before, after) -> jax.Array:
     (a blinking message's timer, a key poll), and under a random policy a game in play redraws
     something within 2 s. The cost: under "noop", a game that moves only on a key stalls at once.
     """
-    return jnp.all(before.screen == after.screen)
+    return jnp.all(shown(before) == shown(after))

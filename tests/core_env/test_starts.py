@@ -114,8 +114,9 @@ def test_reset_and_autoreset_run_no_loop_whatever_noop_max(ticker, noop_max):
     assert _loops(reset.jaxpr) == []
     _, state = env.reset(jax.random.key(0), params)
     step = jax.make_jaxpr(env.step)(jax.random.key(1), state, 1, params)
-    assert _loops(step.jaxpr) == ["scan", "scan"]  # frames, and instructions within a frame
-    # From 25 instructions a frame skip_idle (the default) runs one loop over instruction chunks.
+    # the one frame loop (octax_core.emulator.frame): frames, and instructions within a frame
+    assert _loops(step.jaxpr) == ["while", "scan"]
+    # From 25 instructions a frame skip_idle (the default) runs the same loop over instruction chunks.
     env, params, _ = ticker(noop_max, autoreset=True, instructions_per_frame=100)
     _, state = env.reset(jax.random.key(0), params)
     step = jax.make_jaxpr(env.step)(jax.random.key(1), state, 1, params)
