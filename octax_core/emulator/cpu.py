@@ -99,6 +99,7 @@ class Fetched(NamedTuple):
     fields: Decoded
     kind: jax.Array  # int32 Kind; STALL while the frame is over (display wait)
     context: Context
+    at_i: jax.Array  # int32 bytes at I: the 16 of the window, or 32 (a 16x16 sprite) after CHIP-8
 
 
 def fetch(platform: Platform, quirks: Quirks, state: MachineState, keys, stalled=None) -> Fetched:
@@ -111,7 +112,9 @@ def fetch(platform: Platform, quirks: Quirks, state: MachineState, keys, stalled
     """
     pc, I = state.pc.astype(jnp.int32), state.I.astype(jnp.int32)
     code = jax.lax.dynamic_slice(state.memory, (pc + MEMORY_OFFSET,), (platform.fetch_bytes,)).astype(jnp.int32)
-    window = jax.lax.dynamic_slice(state.memory, (I + MEMORY_OFFSET,), (16,)).astype(jnp.int32)
+    at_i = jax.lax.dynamic_slice(state.memory, (I + MEMORY_OFFSET,), (32 if platform.wide_sprites else 16,))
+    at_i = at_i.astype(jnp.int32)
+    window = at_i[:16]
     fields = decode(code[0], code[1], platform)
     kind = fields.kind if stalled is None else jnp.where(stalled, int(Kind.STALL), fields.kind)
     V, sp = state.V.astype(jnp.int32), state.sp.astype(jnp.int32)
@@ -129,7 +132,7 @@ def fetch(platform: Platform, quirks: Quirks, state: MachineState, keys, stalled
         ext = state.extension
         context = context._replace(hires=ext.hires, flags=ext.flags.astype(jnp.int32),
                                    plane=ext.plane.astype(jnp.int32))
-    return Fetched(fields, kind, context)
+    return Fetched(fields, kind, context, at_i)
 
 
 def merge(kind, effects: dict, defaults: Effect) -> Effect:
@@ -194,9 +197,11 @@ def execute(platform: Platform, quirks: Quirks, state: MachineState, keys: jax.A
     """
     fetched = fetch(platform, quirks, state, keys, stalled)
     kind, c = fetched.kind, fetched.context
-    # The memory write goes first and DXYN, the one handler that reads the collision, after it,
-    # taking its sprite from the written memory: DXYN writes no memory, so those are the same
-    # bytes, and XLA never has to copy the memory buffer to keep the old version alive.
+    # The memory write goes first and DXYN, the one handler that reads the collision, after it:
+    # its sprite is the bytes fetched at I before the write (16, or 32 after CHIP-8), and XO-CHIP's
+    # plane 2 is read from the written memory. DXYN writes no memory, so those are the same bytes,
+    # and XLA never has to copy the memory buffer to keep the old version alive (a read of the old
+    # memory after the write costs a whole 64 KiB copy per instruction on XO-CHIP, measured).
     effects = {k: handler(c) for k, handler in handlers(platform).items()}
     defaults = _defaults(state, c)
     before_drawing = merge(kind, effects, defaults)  # all but DXYN's VF, which needs the collision
@@ -205,7 +210,7 @@ def execute(platform: Platform, quirks: Quirks, state: MachineState, keys: jax.A
     # rare ones first (scrolls, hires clears), each straight on the state's surfaces.
     screen, grid = _scroll_and_clear_hires(platform, state, before_drawing, c)
     drawing = kind == Kind.DRW
-    grid, collision, mask = _draw(platform, quirks, screen, grid, written, c, drawing, fetched.fields.n)
+    grid, collision, mask = _draw(platform, quirks, screen, grid, written, fetched, drawing)
     effects[Kind.DRW] = display.op_dxyn(c._replace(collision=collision))
     effect = merge(kind, effects, defaults)
     screen = _draw_lores(platform, screen, mask, effect, c)
@@ -233,17 +238,19 @@ def write_window(platform: Platform, memory, window, I):
     return jax.lax.dynamic_update_slice(memory, window, (other + MEMORY_OFFSET,))
 
 
-def _sprite_data(platform: Platform, memory, c: Context):
+def _sprite_data(platform: Platform, memory, fetched: Fetched):
     """The bytes a sprite is drawn from: CHIP-8's (16,) at I (the window), or (planes, 32) after
-    it: plane 1's at I, plane 2's after plane 1's rows when both planes are drawn, else at I too."""
+    it: plane 1's at I (read with the window), plane 2's after plane 1's rows when both planes are
+    drawn, else at I too, read from `memory`, the written one (see `execute`)."""
     if not platform.extended:
-        return c.window
-    first = jax.lax.dynamic_slice(memory, (c.I + MEMORY_OFFSET,), (32,))
+        return fetched.at_i
+    first = fetched.at_i
     if platform.planes == 1:
-        return first[None, :].astype(jnp.int32)
+        return first[None, :]
+    c = fetched.context
     size = jnp.where(c.n == 0, 32, c.n) * (c.plane & 1)  # plane 1's bytes, when plane 1 is drawn
-    second = jax.lax.dynamic_slice(memory, (c.I + size + MEMORY_OFFSET,), (32,))
-    return jnp.stack([first, second]).astype(jnp.int32)
+    second = jax.lax.dynamic_slice(memory, (c.I + size + MEMORY_OFFSET,), (32,)).astype(jnp.int32)
+    return jnp.stack([first, second])
 
 
 class _Sprite(NamedTuple):
@@ -293,7 +300,7 @@ class _Sprite(NamedTuple):
     height: jax.Array
 
 
-def _draw(platform: Platform, quirks: Quirks, screen, grid, memory, c: Context, drawing, n):
+def _draw(platform: Platform, quirks: Quirks, screen, grid, memory, fetched: Fetched, drawing):
     """DXYN: (the grid with the hires sprite drawn, the collision, the XOR mask of the 64x32
     sprite: all zero for any other instruction, and for a machine in hires).
 
@@ -301,7 +308,8 @@ def _draw(platform: Platform, quirks: Quirks, screen, grid, memory, c: Context, 
     every machine (`_draw_lores`, a zero mask where it does not draw); the 128x64 grid only
     under `when_any`, when some machine of the batch draws in hires.
     """
-    patterns, height = display.sprite_patterns(_sprite_data(platform, memory, c), n, platform.wide_sprites)
+    c, n = fetched.context, fetched.fields.n
+    patterns, height = display.sprite_patterns(_sprite_data(platform, memory, fetched), n, platform.wide_sprites)
     if not platform.extended:
         mask = display.sprite_mask(patterns, c.vx & 63, c.vy & 31, jnp.where(drawing, height, 0), display.LORES,
                                    quirks.clipping)
