@@ -102,9 +102,9 @@ class Env:
         """
         machine = starts.draw(self._starts, key)
         state = EnvState(machine=machine, score=self._score(machine), episode_step=jnp.int32(0),
-                         last_action=jnp.int32(0), done=jnp.bool_(False))
-        obs = jnp.broadcast_to(self._observe(shown(machine)[None]), self.observation_shape)
-        return obs, state
+                         last_action=jnp.zeros(self._action_shape, jnp.int32), done=jnp.bool_(False))
+        screens = jnp.broadcast_to(shown(machine)[None], (self.config.frames_per_step, *shown(machine).shape))
+        return self._observe(screens), state
 
     def step_env(self, key: jax.Array, state: EnvState, action, params: EnvParams):
         """Holds the action's key for `frames_per_step` frames; `key` draws the sticky action.
@@ -113,14 +113,17 @@ class Env:
             obs, state, reward, terminated, truncated, info. Once an episode has ended, further
             steps return the same state, zero reward and the same flags.
         """
-        action = self._check_action(action)
-        repeat = jax.random.uniform(key) < params.repeat_action_probability
+        return self._transition(key, state, self._check_action(action), params)
+
+    def _transition(self, key: jax.Array, state: EnvState, action: jax.Array, params: EnvParams):
+        """`step_env` after the action is checked: one env (`action` ()) or one per seat (`MultiEnv`)."""
+        repeat = jax.random.uniform(key, jnp.shape(action)) < params.repeat_action_probability
         action = jnp.where(repeat, state.last_action, action)
         # pgx's rule: an ended episode stands still until it is reset. The machine is halted
         # rather than stepped and then discarded, so its 4 KB of memory is never selected over,
         # and the frames it returns are its last screen.
         machine, screens = _play(self.machine, self.config.frames_per_step, self.config.freeze_timers,
-                                 state.machine, jnp.asarray(self._action_masks)[action], halted=state.done)
+                                 state.machine, self._keys_held(action), halted=state.done)
         score = self._score(machine)
         terminated = jnp.asarray(self.spec.terminated_fn(machine), jnp.bool_)
         if machine.extension is not None:  # 00FD: the program has ended, so has the episode
@@ -168,7 +171,13 @@ class Env:
         """The per-step info of one env: score, lives (-1 where the game keeps none), episode_step."""
         return {"score": state.score, "lives": self._lives(state.machine), "episode_step": state.episode_step}
 
-    # --- pieces -------------------------------------------------------------------------------
+    # --- pieces (`MultiEnv` replaces those that differ for two seats) ---------------------------
+
+    _action_shape: tuple[int, ...] = ()  # one action a step
+
+    def _keys_held(self, action: jax.Array) -> jax.Array:
+        """The keypad mask the action holds."""
+        return jnp.asarray(self._action_masks)[action]
 
     def _observe(self, screens) -> jax.Array:
         if not self.machine.platform.extended:
@@ -231,5 +240,8 @@ def make(game: Union[str, GameSpec], *, rom=None, **options: Any) -> tuple[Env, 
     >>> obs, state = env.reset(jax.random.key(0), params)            # doctest: +SKIP
     """
     spec = game if isinstance(game, GameSpec) else get_spec(game)
+    if not spec.solo:
+        raise ValueError(f"{spec.id} is played by two (its second player must move for the game to go on): "
+                         f"use octax_core.make_multi({spec.id!r}), or a fixed opponent in the Gymnasium layer")
     config, params = make_config(spec, **options)
     return Env(spec, config, rom), params

@@ -12,7 +12,7 @@ import importlib
 import pkgutil
 from typing import Optional
 
-from octax_core.env.games.spec import (CATEGORIES, GameSpec, bcd_value, in_routine, key_mask, ram_value,
+from octax_core.env.games.spec import (CATEGORIES, GameSpec, Seats, bcd_value, in_routine, key_mask, ram_value,
                                        register_value)
 
 SUITES = {
@@ -51,16 +51,23 @@ def _discover(package: str = __name__, path=__path__, suite: str = "octax") -> N
             register(spec, getattr(games, "SUITE", suite))
 
 
-def list_games(suite: Optional[str] = None) -> list[str]:
-    """Ids of the registered games of `suite` (every game when None), sorted.
+def list_games(suite: Optional[str] = None, players: Optional[int] = None) -> list[str]:
+    """Ids of the registered games of `suite` (every suite when None), sorted.
+
+    `players=None` or 1 lists the games one agent plays (`make`); `players=2` lists the two-player
+    games (`make_multi`), which include two-player games that are not one-player envs too.
 
     Raises:
-        ValueError: an unknown suite; the message lists the valid ones (`SUITES`).
+        ValueError: an unknown suite or player count; the message lists the valid ones.
     """
-    if suite is None:
-        return sorted(_REGISTRY)
-    _check_suite(suite)
-    return sorted(game for game, its_suite in _SUITE_OF.items() if its_suite == suite)
+    if players not in (None, 1, 2):
+        raise ValueError(f"players must be 1 or 2 (or None for 1), got {players!r}")
+    if suite is not None:
+        _check_suite(suite)
+    def wanted(spec: GameSpec) -> bool:
+        return spec.players == 2 if players == 2 else spec.solo
+    return sorted(game for game, its_suite in _SUITE_OF.items()
+                  if (suite is None or its_suite == suite) and wanted(_REGISTRY[game]))
 
 
 def suite_of(game_id: str) -> str:
@@ -78,10 +85,10 @@ def get_spec(game_id: str) -> GameSpec:
     try:
         return _REGISTRY[game_id]
     except KeyError:
-        raise KeyError(f"unknown game {game_id!r}; valid ids: {', '.join(list_games())}") from None
+        raise KeyError(f"unknown game {game_id!r}; valid ids: {', '.join(sorted(_REGISTRY))}") from None
 
 
 _discover()
 
-__all__ = ["CATEGORIES", "GameSpec", "SUITES", "bcd_value", "get_spec", "in_routine", "key_mask", "list_games", "ram_value", "register",
+__all__ = ["CATEGORIES", "GameSpec", "SUITES", "Seats", "bcd_value", "get_spec", "in_routine", "key_mask", "list_games", "ram_value", "register",
            "register_value", "suite_of"]

@@ -20,6 +20,64 @@ StateFn = Callable[[MachineState], jax.Array]
 
 
 @dataclasses.dataclass(frozen=True)
+class Seats:
+    """How two players share one machine: each seat's keys, each seat's score, whose turn it is.
+
+    Both seats' keys reach the one keypad in the same step (a key held by either is held), as on
+    the real machine, where two people press one hex keypad (or one PC keyboard) together.
+
+    Attributes:
+        action_keys: per seat, the CHIP-8 keys its actions 1..k hold (action 0 is no-op). Every
+            seat has the same number of actions; seats may share keys (a hot-seat game whose two
+            players type on the same keys in turn).
+        score_fn: state -> (seats,) scores, one per seat (int32 or float32); a seat's reward is
+            the change of its score over the step.
+        turn_fn: state -> int32 seat to move, for a turn-based game; None (the default) for a
+            simultaneous one. The seat whose turn it is not may only play no-op (its legal mask
+            holds action 0 alone); the functional env turns any other action of it into no-op.
+        legal_fn: state -> (num_actions,) bool, the actions open to the seat to move (action 0,
+            no-op, is always open); None (the default) opens every action.
+        zero_sum: the seats' rewards sum to 0 on every step (a win is the other's loss).
+        startup: the two-player mode's start-up, replacing `GameSpec.startup` in the multi-agent
+            env (a menu that picks one or two players); None keeps the spec's.
+        names: the seats' names in the game (for docs and renderers): "left ship", "X".
+        scripted_policy: (state, seat) -> int32 action: a hand-written player for either seat
+            that reads the machine (registers, RAM) as a bot would, pure JAX so that it runs
+            batched inside a jitted rollout (`seat` is a Python int); the opponent self-play is
+            evaluated against. None where the game has none.
+    """
+
+    action_keys: tuple[tuple[int, ...], ...]
+    score_fn: StateFn
+    turn_fn: Optional[StateFn] = None
+    legal_fn: Optional[StateFn] = None
+    zero_sum: bool = False
+    startup: Optional[tuple[tuple[int, int], ...]] = None
+    names: tuple[str, ...] = ("player 1", "player 2")
+    scripted_policy: Optional[Callable[[MachineState, int], jax.Array]] = None
+
+    def __post_init__(self):
+        if len(self.action_keys) != 2:
+            raise ValueError(f"Seats: two seats are supported, got {len(self.action_keys)}")
+        counts = {len(keys) for keys in self.action_keys}
+        if len(counts) != 1 or 0 in counts:
+            raise ValueError(f"Seats: every seat needs the same number (>= 1) of action keys, got {self.action_keys}")
+        for keys in self.action_keys:
+            if any(not 0 <= k <= 15 for k in keys) or len(set(keys)) != len(keys):
+                raise ValueError(f"Seats: a seat's keys are distinct CHIP-8 keys 0..15, got {keys}")
+        if len(self.names) != len(self.action_keys):
+            raise ValueError(f"Seats: one name per seat, got {self.names}")
+
+    @property
+    def players(self) -> int:
+        return len(self.action_keys)
+
+    @property
+    def turn_based(self) -> bool:
+        return self.turn_fn is not None
+
+
+@dataclasses.dataclass(frozen=True)
 class GameSpec:
     """One game as an environment.
 
@@ -50,6 +108,12 @@ class GameSpec:
         category: the paper's category (see `CATEGORIES`).
         description: one paragraph: goal, keys, reward, termination.
         version: bumped when behaviour changes (the Gymnasium id's -vN).
+        seats: a two-player game's `Seats` (`octax_core.make_multi` builds its multi-agent env);
+            None (the default) for a one-player game.
+        solo: the game is also a one-player env (`make`; player 2, where there is one, holds no
+            key). A turn-based game that waits for its second player is not: False leaves it out
+            of `list_games()` and refuses `make`; it is played by `make_multi`, or alone against
+            a fixed opponent in the Gymnasium layer.
     """
 
     id: str
@@ -71,6 +135,8 @@ class GameSpec:
     survival_reward: float = 0.0
     max_episode_steps: int = 5000
     version: int = 0
+    seats: Optional[Seats] = None
+    solo: bool = True
 
     def __post_init__(self):
         platform = resolve_platform(self.platform)  # an unknown name raises, listing the valid ones
@@ -89,6 +155,13 @@ class GameSpec:
             raise ValueError(f"{self.id}: instructions_per_frame must be positive, got {self.instructions_per_frame}")
         if self.max_episode_steps <= 0:
             raise ValueError(f"{self.id}: max_episode_steps must be positive, got {self.max_episode_steps}")
+        if not self.solo and self.seats is None:
+            raise ValueError(f"{self.id}: a game that is not solo must have seats (it is played by two)")
+
+    @property
+    def players(self) -> int:
+        """The most players the game takes: 2 where it has `seats`, else 1."""
+        return 1 if self.seats is None else self.seats.players
 
 
 CATEGORIES = (

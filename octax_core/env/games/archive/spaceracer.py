@@ -30,9 +30,13 @@ and depends only on the actions.
 """
 
 from octax_core.env.games.archive._program import archive_spec
-from octax_core.env.games.spec import key_mask
+import jax.numpy as jnp
+
+from octax_core.env.games.spec import Seats, key_mask
 
 SCORE1 = 9  # `:alias score1 v9`
+SCORE2 = 12  # `:alias score2 vc`
+SHIP_Y = (8, 11)  # `:alias ship1y v8`, `:alias ship2y vb`
 TIMER_LINE = 6  # `:alias timer_line v6`
 TIME_UP = 19  # `if timer_line != 19 then again`: the main play loop's end
 
@@ -47,6 +51,11 @@ SPECS = (archive_spec(
     terminated_fn=lambda state: state.V[TIMER_LINE] == TIME_UP,
     startup=((0, 200),) + _PRESS_4 * 3,
     max_episode_steps=4500,
+    seats=Seats(
+        action_keys=((4, 7), (0xD, 0xE)),  # 4/Q up, 7/A down; D/R up, E/F down (the ROM's keys page)
+        score_fn=lambda state: jnp.stack([state.V[SCORE1], state.V[SCORE2]]).astype(jnp.int32),
+        names=("ship 1 (left)", "ship 2 (right)"),
+    ),
     category="timing",
     description="Fly ship 1 up through a scrolling starfield with key 4 (key 7 down); reward +1 "
                 "each time it reaches the top, a star hit sends it back to the start; the episode "

@@ -1,0 +1,160 @@
+"""Two players on one machine: the functional multi-agent env (pgx and JaxMARL are the models).
+
+    env, params = octax_core.make_multi("Duel")
+    obs, state = env.reset(key, params)                    # obs: (players, planes, H, W)
+    obs, state, rewards, terminated, truncated, info = env.step(key, state, actions, params)
+
+`MultiEnv` is the one-player `Env` with one action per seat: the same machine, start pool, frame
+loop, sticky actions, truncation and autoreset (`Env._transition`, `Env.autoreset`), with the
+pieces that differ for two seats replaced:
+
+- actions: int32 `(players,)`; action 0 of a seat is no-op and action i holds
+  `seats.action_keys[seat][i - 1]`. Both seats' keys reach the one keypad in the same step: a key
+  held by either is held. With sticky actions each seat repeats its own last action.
+- rewards: float32 `(players,)`, the change of each seat's score (`Seats.score_fn`).
+  `terminated` and `truncated` are shared: one machine, one episode.
+- observations: uint8 `(players, frames_per_step + 1, H, W)`: the screens of the step (the same
+  for both seats), then a player plane, 0 everywhere for the first seat and `obs_scale` for the
+  second. One screen, two readers: a player plane tells each which side it plays in every game,
+  turn-based, simultaneous or XO-CHIP, where a mirrored view would work only for games whose two
+  sides are each other's reflection, and would hide a turn-based game's X from its O.
+- turn-based games (`Seats.turn_fn`): `info["current_player"]` is the seat to move, and
+  `info["legal_action_mask"]` (players, num_actions) opens only no-op to the other seat. Here, in
+  the functional core, an action the mask closes is played as no-op (under `jit` nothing can be
+  raised); the Gymnasium and PettingZoo layers raise an error for it instead. Simultaneous games
+  have `current_player` -1 and every action open to both seats.
+
+Everything is for one env: batch with `jax.vmap` (`in_axes=(0, 0, 0, None)`), as for `Env`.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from typing import Any, Union
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+
+from octax_core.emulator.state import MachineState
+from octax_core.env.config import make_config
+from octax_core.env.environment import Env, EnvParams, EnvState
+from octax_core.env.games import GameSpec, get_spec, list_games
+
+
+class MultiEnv(Env):
+    """A two-player game: one machine, one action, one reward and one observation per seat.
+
+    See the module docstring for the spaces. `num_actions` is per seat (every seat has as many).
+    """
+
+    def __init__(self, spec: GameSpec, config, rom_path=None):
+        if spec.seats is None:
+            raise ValueError(f"{spec.id} is a one-player game; two-player games: {', '.join(list_games(players=2))}")
+        self.seats = spec.seats
+        startup = spec.startup if spec.seats.startup is None else spec.seats.startup
+        super().__init__(dataclasses.replace(spec, startup=startup), config, rom_path)
+        self.spec = spec
+        self._seat_masks = np.array([[0] + [1 << k for k in keys] for keys in spec.seats.action_keys], np.uint32)
+        self._action_masks = self._seat_masks[0]  # num_actions: every seat has as many
+
+    @property
+    def players(self) -> int:
+        return self.seats.players
+
+    @property
+    def agents(self) -> tuple[str, ...]:
+        """The seats' names as PettingZoo's Atari envs name them: first_0, second_0."""
+        return ("first_0", "second_0")[: self.players]
+
+    @property
+    def turn_based(self) -> bool:
+        return self.seats.turn_based
+
+    @property
+    def observation_shape(self) -> tuple[int, int, int]:
+        """One seat's observation: the step's screens, then the player plane."""
+        frames, height, width = super().observation_shape
+        return (frames + 1, height, width)
+
+    # --- the pure game ------------------------------------------------------------------------
+
+    def step_env(self, key: jax.Array, state: EnvState, actions, params: EnvParams):
+        """`Env.step_env` with one action per seat; a closed action (see `legal_action_mask`) is no-op."""
+        actions = self._check_action(actions)
+        actions = jnp.where(self.legal_action_mask(state)[jnp.arange(self.players), actions], actions, 0)
+        return self._transition(key, state, actions, params)
+
+    def current_player(self, state: EnvState) -> jax.Array:
+        """int32: the seat to move in a turn-based game, -1 in a simultaneous one."""
+        if not self.turn_based:
+            return jnp.int32(-1)
+        return jnp.asarray(self.seats.turn_fn(state.machine), jnp.int32)
+
+    def legal_action_mask(self, state: EnvState) -> jax.Array:
+        """bool (players, num_actions): the actions open to each seat now (no-op always is)."""
+        everything = jnp.ones((self.players, self.num_actions), jnp.bool_)
+        if not self.turn_based:
+            return everything
+        open_to_mover = everything[0]
+        if self.seats.legal_fn is not None:
+            open_to_mover = jnp.asarray(self.seats.legal_fn(state.machine), jnp.bool_).at[0].set(True)
+        only_noop = jnp.arange(self.num_actions) == 0
+        mover = self.current_player(state)
+        return jnp.where((jnp.arange(self.players) == mover)[:, None], open_to_mover[None], only_noop[None])
+
+    def info(self, state: EnvState) -> dict[str, jax.Array]:
+        """`Env.info` (score per seat) plus `current_player` and `legal_action_mask`."""
+        return {**super().info(state), "current_player": self.current_player(state),
+                "legal_action_mask": self.legal_action_mask(state)}
+
+    # --- pieces -------------------------------------------------------------------------------
+
+    @property
+    def _action_shape(self) -> tuple[int, ...]:
+        return (self.players,)
+
+    def _keys_held(self, actions: jax.Array) -> jax.Array:
+        """Either seat's key is held: the OR of the seats' masks."""
+        held = jnp.asarray(self._seat_masks)[jnp.arange(self.players), actions]
+        return jax.lax.reduce(held, np.uint32(0), jax.lax.bitwise_or, (0,))
+
+    def _observe(self, screens) -> jax.Array:
+        frames = super()._observe(screens)
+        plane = jnp.arange(self.players, dtype=frames.dtype) * jnp.asarray(self.config.obs_scale, frames.dtype)
+        planes = jnp.broadcast_to(plane[:, None, None, None], (self.players, 1, *frames.shape[1:]))
+        return jnp.concatenate([jnp.broadcast_to(frames[None], (self.players, *frames.shape)), planes], axis=1)
+
+    def _score(self, machine: MachineState) -> jax.Array:
+        scores = jnp.asarray(self.seats.score_fn(machine), jnp.float32)
+        if scores.shape != (self.players,):
+            raise ValueError(f"{self.spec.id}: Seats.score_fn must give ({self.players},) scores, got {scores.shape}")
+        return scores
+
+    def _check_action(self, actions) -> jax.Array:
+        if not isinstance(actions, jax.core.Tracer):
+            value = np.asarray(actions)
+            if value.shape != (self.players,) or not np.issubdtype(value.dtype, np.integer):
+                raise TypeError(f"{self.spec.id}: actions are {self.players} integers, one per seat "
+                                f"({', '.join(self.agents)}); got {value.dtype} of shape {value.shape}")
+            if ((value < 0) | (value >= self.num_actions)).any():
+                raise ValueError(f"{self.spec.id}: actions {value.tolist()} out of range; each seat's actions are "
+                                 f"0..{self.num_actions - 1} (0 = no-op)")
+        elif jnp.shape(actions) != (self.players,):
+            raise TypeError(f"{self.spec.id}: actions must have shape ({self.players},), got {jnp.shape(actions)}")
+        actions = jnp.asarray(actions, jnp.int32)
+        return jnp.where((actions >= 0) & (actions < self.num_actions), actions, 0)
+
+
+def make_multi(game: Union[str, GameSpec], *, rom=None, **options: Any) -> tuple[MultiEnv, EnvParams]:
+    """Builds the two-player env of a game in `list_games(players=2)` (or your `GameSpec` with seats).
+
+    Takes the same options as `octax_core.make` (`ENV_OPTIONS`).
+
+    Raises:
+        KeyError: unknown game id. ValueError: a one-player game (the message lists the two-player
+        ones) or an option out of range. TypeError: an unknown option.
+    """
+    spec = game if isinstance(game, GameSpec) else get_spec(game)
+    config, params = make_config(spec, **options)
+    return MultiEnv(spec, config, rom), params
