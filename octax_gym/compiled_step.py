@@ -14,13 +14,22 @@ what Gymnasium adds to the core:
 * the info dict gets Gymnasium's `_name` masks, and SAME_STEP its batched `final_obs`/`final_info`;
 * device actions get their range checked in the step (`octax_gym.action_check`).
 
-`CompiledStep`s are cached per (game, config, ROM), so every env of one game shares its compilations.
+Two-player games run through the same class: built over a `MultiEnv` (`octax_core.make_multi`)
+the batch of actions is (N, 2), rewards (N, 2), observations (N, 2, F+1, H, W), and the device
+report also catches closed actions (`action_check.accumulate_seats`); that is
+`octax_gym.MultiAgentVectorEnv`. Built with a `View` (`octax_gym.opponent`) it is one seat against
+a fixed opponent: the learner's actions (N,) go in, the opponent's are made inside the step (or
+come from the host), and the learner's observation, reward and info come out, so that
+`OctaxVectorEnv(game, opponent=...)` is a one-player env to every caller.
+
+`CompiledStep`s are cached per (game, config, ROM, players, view), so every env of one game shares
+its compilations.
 """
 
 from __future__ import annotations
 
 import functools
-from typing import Any, Optional
+from typing import Any, Optional, Union
 
 import jax
 import jax.numpy as jnp
@@ -29,8 +38,11 @@ from gymnasium.vector import AutoresetMode
 
 import octax_core
 from octax_core.env import ENV_OPTIONS, Env, EnvConfig, EnvParams, EnvState, GameSpec
-from octax_gym import action_check
-from octax_gym.game_names import resolve_spec
+from octax_core.env.games import get_spec, list_games
+from octax_core.env.multi import MultiEnv
+from octax_gym import action_check, opponent
+from octax_gym.choices import UnknownOptionError
+from octax_gym.game_names import env_id, resolve_spec
 
 # What the Gymnasium envs pass to the core: every env option but `autoreset`, which Gymnasium's
 # own `autoreset_mode` replaces.
@@ -44,12 +56,21 @@ def advance(key: jax.Array) -> tuple[jax.Array, jax.Array, jax.Array]:
 
 
 class CompiledStep:
-    """The jitted reset and step of one game and config, for any batch size."""
+    """The jitted reset and step of one game and config, for any batch size.
 
-    def __init__(self, env: Env):
-        self.env = env
-        self.info = jax.vmap(env.info)
-        self._autoreset = jax.vmap(env.autoreset, in_axes=(0, 0, 0, 0, None))
+    `env` is an `Env`, or a `MultiEnv` for two seats; `view` (a `MultiEnv` only) makes it one seat
+    against a fixed opponent (see the module docstring).
+    """
+
+    def __init__(self, env: Env, view: Optional[opponent.View] = None):
+        self.env, self.view = env, view
+        self.players = env.players if isinstance(env, MultiEnv) else 1
+        if view is None:
+            self.info = jax.vmap(env.info)
+            self._autoreset = jax.vmap(env.autoreset, in_axes=(0, 0, 0, 0, None))
+        else:
+            self.info = jax.vmap(lambda state: opponent.learner_info(env.info(state), view.seat))
+            self._autoreset = jax.vmap(self._learner_autoreset, in_axes=(0, 0, 0, 0, None))
         self.reset = jax.jit(self._reset)
         self.step = {mode: jax.jit(functools.partial(self._step, mode=mode), donate_argnums=(1,))
                      for mode in AutoresetMode}
@@ -61,19 +82,31 @@ class CompiledStep:
         next_keys, _, reset_keys = jax.vmap(advance)(keys)
         if state is None:
             obs, state = jax.vmap(self.env.reset, in_axes=(0, None))(reset_keys, params)
+            if self.view is not None:
+                obs = obs[:, self.view.seat]
         else:
             obs, state = self._autoreset(reset_keys, mask, obs, state, params)
             next_keys = select_keys(mask, next_keys, keys)
         return next_keys, obs, state, self._with_masks(self.info(state))
 
-    def _step(self, keys, state: EnvState, actions, report, params: EnvParams, *, mode: AutoresetMode):
+    def _step(self, keys, state: EnvState, actions, report, params: EnvParams, opponent_actions=None, *,
+              mode: AutoresetMode):
         """One batched step; also returns the action report (`octax_gym.action_check`) updated
-        with this step's actions, as its last output."""
-        report = action_check.accumulate(report, actions, self.env.num_actions)
+        with this step's actions, as its last output. `opponent_actions` (N,): a host function
+        opponent's (a view with opponent "callable" only)."""
+        if self.players == 1:
+            report = action_check.accumulate(report, actions, self.env.num_actions)
         next_keys, step_keys, reset_keys = jax.vmap(advance)(keys)
         was_done = state.done
+        if self.players > 1:
+            if self.view is not None:
+                actions = opponent.actions_of_both(self.env, self.view, step_keys, state, actions, opponent_actions)
+            report = self._accumulate_seats(report, state, actions)
         obs, state, reward, terminated, truncated, info = jax.vmap(
             self.env.step, in_axes=(0, 0, 0, None))(step_keys, state, actions, params)
+        if self.view is not None:
+            seat = self.view.seat
+            obs, reward, info = obs[:, seat], reward[:, seat], opponent.learner_info(info, seat)
         if mode == AutoresetMode.NEXT_STEP:
             # The step after an episode's end is its reset: the action is ignored, and the core
             # already gave the ended (standing-still) row reward 0; its flags are cleared here.
@@ -89,6 +122,23 @@ class CompiledStep:
             return next_keys, obs, state, reward, terminated, truncated, info, report
         return next_keys, obs, state, reward, terminated, truncated, self._with_masks(info), report
 
+    def _accumulate_seats(self, report, state: EnvState, actions):
+        """The two-seat report: out-of-range actions, and closed ones where an episode is on and
+        the seat is not a view's opponent (a closed opponent action is its no-op, not an error)."""
+        open_actions = jax.vmap(self.env.legal_action_mask)(state) | state.done[:, None, None]
+        if self.view is not None:
+            open_actions = open_actions.at[:, self.view.other].set(True)
+        mover = jax.vmap(self.env.current_player)(state)
+        return action_check.accumulate_seats(report, actions, open_actions, mover, self.env.num_actions)
+
+    def _learner_autoreset(self, key, mask, obs, state: EnvState, params: EnvParams):
+        """`Env.autoreset` of one env seen from the view's seat: `obs` is the learner's alone, so
+        the other seat's rows are a stand-in that the new episode's replace or that is dropped."""
+        seat = self.view.seat
+        both = jnp.zeros((self.players, *obs.shape), obs.dtype).at[seat].set(obs)
+        both, state = self.env.autoreset(key, mask, both, state, params)
+        return both[seat], state
+
     @staticmethod
     def _with_masks(info: dict) -> dict:
         """Gymnasium's vector-info convention: each key `k` comes with a bool mask `_k`."""
@@ -103,16 +153,53 @@ def select_keys(mask, on_true, on_false):
 
 
 @functools.lru_cache(maxsize=64)
-def _compiled_step(spec: GameSpec, config: EnvConfig, rom: Optional[str]) -> CompiledStep:
-    return CompiledStep(Env(spec, config, rom))
+def _compiled_step(spec: GameSpec, config: EnvConfig, rom: Optional[str], players: int = 1,
+                   view: Optional[opponent.View] = None) -> CompiledStep:
+    if players == 1:
+        return CompiledStep(Env(spec, config, rom))
+    return CompiledStep(MultiEnv(spec, config, rom), view)
 
 
-def build(game: Any, rom, options: dict[str, Any]) -> tuple[CompiledStep, EnvParams]:
-    """The cached compiled step and checked params for a game (any name `game_names.resolve_spec`
-    takes, or a `GameSpec`) and `GYM_ENV_OPTIONS` keywords (None means the game's default)."""
-    spec = resolve_spec(game)
+def build(game: Any, rom, options: dict[str, Any], *, players: int = 1,
+          view: Optional[opponent.View] = None) -> tuple[CompiledStep, EnvParams]:
+    """The cached compiled step and checked params for a game (any name `resolve_game` takes, or a
+    `GameSpec`) and `GYM_ENV_OPTIONS` keywords (None means the game's default).
+
+    `players=2` builds the two-player env (`octax_core.make_multi`), seen from one seat against
+    an opponent when `view` is given.
+
+    Raises:
+        ValueError: `players=2` for a one-player game (the message lists the two-player ones).
+    """
+    spec = resolve_game(game, players)
+    if players == 2 and spec.seats is None:
+        raise ValueError(f"{spec.id} is a one-player game; two-player games: {', '.join(list_games(players=2))}")
     config, params = octax_core.make_config(spec, autoreset=False, **options)  # checks every value
-    return _compiled_step(spec, config, None if rom is None else str(rom)), params
+    return _compiled_step(spec, config, None if rom is None else str(rom), players, view), params
+
+
+def resolve_game(game: Union[str, GameSpec], players: int = 1) -> GameSpec:
+    """`game_names.resolve_spec`, plus the two-player games that are not one-player envs
+    (`GameSpec.solo` False), which `list_games()` leaves out: "Tank", "octax/Tank-v0", any case.
+
+    Raises:
+        TypeError, UnknownOptionError: as `resolve_spec`; with `players=2` the message lists the
+        two-player games.
+    """
+    if isinstance(game, GameSpec) or not isinstance(game, str):
+        return resolve_spec(game)
+    two = list_games(players=2)
+    names = {name: name for name in two} | {env_id(name): name for name in two}
+    found = names.get(game) or {name.lower(): game_id for name, game_id in names.items()}.get(game.lower())
+    if found is not None:
+        return get_spec(found)
+    try:
+        return resolve_spec(game)
+    except UnknownOptionError:
+        if players == 1:
+            raise
+    raise UnknownOptionError("two-player game", game, two, f"or their Gymnasium ids ({env_id(two[0])}, ...)"
+                             if two else "", near=names)
 
 
 def seeds_for(seed, num_envs: int) -> list[int]:

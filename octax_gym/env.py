@@ -3,6 +3,9 @@
 It runs the same compiled env step as `OctaxVectorEnv` with a batch of one, so a single env
 seeded s and row i of a vector env seeded s - i play the same game step for step. For many envs
 use `gymnasium.make_vec`: one batched call is far faster than many single envs.
+
+A two-player game is one seat against a fixed opponent with `opponent=` (and `seat=`):
+`gymnasium.make("octax/SpaceRacer-v0", opponent="scripted")`; see `octax_gym.opponent`.
 """
 
 from __future__ import annotations
@@ -14,6 +17,7 @@ import numpy as np
 
 from octax_core.env.config import check_option_names
 from octax_gym import action_check
+from octax_gym import opponent as opponents
 from octax_gym.choices import UnknownOptionError
 from octax_gym.vector import FRAMES_PER_SECOND, KEYWORDS, OctaxVectorEnv
 
@@ -27,12 +31,20 @@ class OctaxEnv(gymnasium.Env):
     autoresets: call `reset()` when an episode ends; steps after the end stand still). With
     backend "jax" or "torch" the observation is a JAX array or a torch tensor sharing its buffer;
     reward, terminated and truncated are Python scalars whatever the backend.
+
+    Against an opponent (`opponent=`, `seat=`: `octax_gym.opponent`) the observation is the
+    learner's, (frames_per_step + 1, H, W) with its player plane last; a function opponent takes
+    one observation and returns one action; `info["action_mask"]` (bool (n,), also
+    `action_masks()`) holds the actions open to the learner, and a closed one raises
+    `IllegalMoveError`.
     """
 
     metadata = {"render_modes": ["rgb_array"], "render_fps": FRAMES_PER_SECOND // 4}
 
     def __init__(self, game: Any, *, render_mode: Optional[str] = None, **options):
         check_option_names(options, SINGLE_KEYWORDS, type(self).__name__)
+        if callable(options.get("opponent")):  # one observation -> one action, run as a batch of one
+            options["opponent"] = opponents.single_env_function(options["opponent"])
         self._vector = OctaxVectorEnv(game, 1, autoreset_mode="disabled", render_mode=render_mode, **options)
         self.render_mode = render_mode
         self.backend = self._vector.backend
@@ -69,9 +81,14 @@ class OctaxEnv(gymnasium.Env):
         """The `octax_core.EnvState` (JAX arrays, batch axis of 1)."""
         return self._vector.state
 
+    def action_masks(self) -> np.ndarray:
+        """bool (n,): the actions open to the learner now (all of them in a one-player env or a
+        simultaneous game), what sb3-contrib's MaskablePPO reads."""
+        return self._vector.action_masks()[0]
+
     @staticmethod
     def _unbatch(info: dict) -> dict:
-        return {name: (value[0].item() if hasattr(value[0], "item") else value[0])
+        return {name: (value[0].item() if hasattr(value[0], "item") and not getattr(value[0], "shape", ()) else value[0])
                 for name, value in info.items() if not name.startswith("_")}
 
     def __repr__(self) -> str:

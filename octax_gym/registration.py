@@ -4,6 +4,10 @@ Gymnasium 1.x has no plugin auto-registration; as with ale-py, importing the pac
 the ids (`import octax_gym; gymnasium.register_envs(octax_gym)` keeps linters from dropping the
 import). Each id has an `entry_point` (`gymnasium.make` -> `OctaxEnv`) and a `vector_entry_point`
 (`gymnasium.make_vec` -> `OctaxVectorEnv`, one batched JAX call instead of N envs in a loop).
+
+The two-player games (`list_games(players=2)`) are registered too, the same way: with
+`opponent=` an id is one seat against a fixed opponent (`octax_gym.opponent`); a game that is
+not a one-player env (`GameSpec.solo` False) raises `OpponentRequiredError` without it.
 """
 
 from __future__ import annotations
@@ -19,22 +23,30 @@ from octax_gym.game_names import NAMESPACE, env_id  # noqa: F401  (where benchma
 
 
 def register_all() -> list[str]:
-    """Registers (or re-registers) every game; returns the Gymnasium ids."""
-    ids = []
-    for game in list_games():
-        gym_id = env_id(game)
-        gymnasium.register(
-            id=gym_id,
-            entry_point="octax_gym.env:OctaxEnv",
-            vector_entry_point="octax_gym.vector:OctaxVectorEnv",
-            kwargs={"game": game},
-            # Truncation is the env's own (`max_episode_steps=` keyword, the game's default
-            # otherwise), counted inside the jitted step, so no TimeLimit wrapper is added.
-            max_episode_steps=None,
-            disable_env_checker=False,
-        )
-        ids.append(gym_id)
-    return ids
+    """Registers (or re-registers) every one-player game; returns the Gymnasium ids."""
+    return [_register(game) for game in list_games()]
+
+
+def register_two_player() -> list[str]:
+    """Registers (or re-registers) every two-player game (`list_games(players=2)`), those that are
+    not one-player envs included; returns their Gymnasium ids."""
+    solo = set(list_games())  # registered by `register_all` already
+    return [env_id(game) if game in solo else _register(game) for game in list_games(players=2)]
+
+
+def _register(game: str) -> str:
+    gym_id = env_id(game)
+    gymnasium.register(
+        id=gym_id,
+        entry_point="octax_gym.env:OctaxEnv",
+        vector_entry_point="octax_gym.vector:OctaxVectorEnv",
+        kwargs={"game": game},
+        # Truncation is the env's own (`max_episode_steps=` keyword, the game's default
+        # otherwise), counted inside the jitted step, so no TimeLimit wrapper is added.
+        max_episode_steps=None,
+        disable_env_checker=False,
+    )
+    return gym_id
 
 
 def register_game(spec: GameSpec, rom: Optional[Union[str, os.PathLike]] = None) -> str:

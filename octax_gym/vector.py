@@ -8,6 +8,10 @@
 
 A step is one jitted call (key split, batched step, autoreset) with no host sync inside; the
 outputs reach numpy, JAX or torch without a copy (`backend=`). See docs/gymnasium.md.
+
+With `opponent=` (and `seat=`) a two-player game is one seat against a fixed opponent, still a
+one-player vector env to its caller (`octax_gym.opponent`, docs/pettingzoo.md); both seats at
+once are `octax_gym.MultiAgentVectorEnv`, a subclass.
 """
 
 from __future__ import annotations
@@ -21,7 +25,7 @@ import numpy as np
 from gymnasium import spaces
 from gymnasium.vector import AutoresetMode
 
-from octax_gym import action_check, backends, compiled_step, render
+from octax_gym import action_check, backends, compiled_step, opponent as opponents, render
 from octax_core.emulator.state import screen_values, shown
 from octax_core.env.config import check_option_names
 from octax_core.validate import check_int
@@ -82,6 +86,15 @@ class OctaxVectorEnv(gymnasium.vector.VectorEnv):
             four (off, plane 1, plane 2, both: XO-CHIP's colours); None (the default) takes the
             game's own (`GameSpec.palette`), else "white".
         rom: an explicit ROM path (its SHA-1 must match the game's).
+        opponent: for a two-player game (`octax_core.list_games(players=2)`), the fixed player of
+            the other seat: "random", "noop", "scripted" (the game's bot) or a function of a batch
+            of the opponent's observations -> its num_envs actions (`octax_gym.opponent`). The
+            env is then the learner's seat alone: observation (frames_per_step + 1, H, W), the
+            last plane the player plane; its own reward; `info["action_mask"]` and
+            `info["current_player"]`; a closed action raises `IllegalMoveError`. None (the
+            default): a one-player env; a game that is not one (`GameSpec.solo` False) then
+            raises `OpponentRequiredError`.
+        seat: the learner's seat against `opponent`: 0 (the default, first_0) or 1 (second_0).
         **env_options: the core env's options (`octax_core.env.config`; None or absent = the
             game's default), all but `autoreset`: frames_per_step, instructions_per_frame,
             obs_scale, freeze_timers and noop_max, fixed at construction (`EnvConfig`), and
@@ -95,8 +108,14 @@ class OctaxVectorEnv(gymnasium.vector.VectorEnv):
                  autoreset_mode: Union[AutoresetMode, str] = AutoresetMode.NEXT_STEP,
                  backend: str = "numpy", device: Any = None, render_mode: Optional[str] = None,
                  render_scale: int = render.DEFAULT_RENDER_SCALE, palette: Optional[render.PaletteArg] = None,
-                 rom=None, **env_options):
+                 rom=None, opponent: Any = None, seat: int = 0, **env_options):
         check_option_names(env_options, KEYWORDS, type(self).__name__)
+        self._setup(game, num_envs, autoreset_mode, backend, device, render_mode, render_scale, palette, rom,
+                    env_options, opponent=opponent, seat=seat)
+
+    def _setup(self, game, num_envs, autoreset_mode, backend, device, render_mode, render_scale, palette, rom,
+               env_options, *, players: int = 1, opponent: Any = None, seat: int = 0):
+        """The construction `MultiAgentVectorEnv` shares: arguments checked, compiled step built."""
         self.num_envs = check_int("num_envs", num_envs)
         self.autoreset_mode = check_autoreset_mode(autoreset_mode)
         self.backend = backends.check_backend(backend)
@@ -105,14 +124,23 @@ class OctaxVectorEnv(gymnasium.vector.VectorEnv):
         self.render_scale = render.check_render_scale(render_scale)
         if palette is not None:
             self.palette = render.resolve_palette(palette)  # a bad one raises before the build
-        self._compiled, params = build(game, rom, env_options)
+        view = self._opponent = None
+        if players == 1:
+            spec = compiled_step.resolve_game(game)
+            view, self._opponent = opponents.resolve(opponent, seat, spec)
+            if view is not None:
+                players, game = 2, spec
+        self.view = view
+        self._compiled, params = build(game, rom, env_options, players=players, view=view)
         self.core_env = self._compiled.env
         self.game_spec = self.core_env.spec
+        self.agents = getattr(self.core_env, "agents", None)  # the seats' names in a two-player env
         if palette is None:
             self.palette = render.resolve_palette(self.game_spec.palette or render.DEFAULT_PALETTE)
         self.params = jax.device_put(params, self.device)
         self._step_fn = self._compiled.step[self.autoreset_mode]
-        self._action_check = action_check.DeferredCheck(self.game_spec.id, self.core_env.num_actions, self.device)
+        self._action_check = action_check.DeferredCheck(self.game_spec.id, self.core_env.num_actions, self.device,
+                                                        self.agents)
 
         config = self.core_env.config
         self.metadata = {**type(self).metadata, "autoreset_mode": self.autoreset_mode,
@@ -122,7 +150,7 @@ class OctaxVectorEnv(gymnasium.vector.VectorEnv):
         self.single_action_space = spaces.Discrete(self.core_env.num_actions)
         self.observation_space = gymnasium.vector.utils.batch_space(self.single_observation_space, self.num_envs)
         self.action_space = gymnasium.vector.utils.batch_space(self.single_action_space, self.num_envs)
-        self._keys = self._state = self._obs = None
+        self._keys = self._state = self._obs = self._info = None
 
     # --- Gymnasium API ----------------------------------------------------------------------
 
@@ -150,6 +178,7 @@ class OctaxVectorEnv(gymnasium.vector.VectorEnv):
         else:
             self._keys, self._obs, self._state, info = self._compiled.reset(
                 self._keys, self._state, self._obs, jax.device_put(mask, self.device), self.params)
+        self._info = info
         return backends.to_backend(self._obs, self.backend), backends.to_backend(info, self.backend)
 
     def step(self, actions):
@@ -163,12 +192,13 @@ class OctaxVectorEnv(gymnasium.vector.VectorEnv):
         """
         if self._state is None:
             raise gymnasium.error.ResetNeeded("call reset() before step()")
-        actions, unchecked = action_check.to_device(actions, self.num_envs, self.single_action_space.n,
-                                                    self.device, self.game_spec.id)
+        actions, unchecked = self._actions_to_device(actions)
         self._action_check.poll()
+        extra = () if self._opponent is None else (self._opponent_actions(),)
         self._keys, self._obs, self._state, reward, terminated, truncated, info, report = self._step_fn(
-            self._keys, self._state, actions, self._action_check.report, self.params)
+            self._keys, self._state, actions, self._action_check.report, self.params, *extra)
         self._action_check.record(report, unchecked)
+        self._info = info
         out = backends.to_backend((self._obs, reward, terminated, truncated, info), self.backend)
         if self.backend == "numpy":  # the outputs were just read back, so the report is ready too
             self._action_check.poll(wait=True)
@@ -186,10 +216,42 @@ class OctaxVectorEnv(gymnasium.vector.VectorEnv):
         return tuple(render.to_rgb(p, self.render_scale, self.palette) for p in pixels)
 
     def close_extras(self, **kwargs):
-        self._keys = self._state = self._obs = None
+        self._keys = self._state = self._obs = self._info = None
         self._action_check.poll(wait=True)  # the last steps' device actions, checked at the latest here
 
     # --- helpers ----------------------------------------------------------------------------
+
+    def _actions_to_device(self, actions) -> tuple[jax.Array, bool]:
+        """The step's actions checked (`octax_gym.action_check`) and on the device; against an
+        opponent, host actions are checked against the learner's `action_mask` too."""
+        actions, unchecked = action_check.to_device(actions, self.num_envs, self.single_action_space.n,
+                                                    self.device, self.game_spec.id)
+        if self.view is not None and self.core_env.turn_based and not unchecked:
+            both = np.zeros((self.num_envs, 2), np.int32)
+            both[:, self.view.seat] = np.asarray(actions)
+            legal = np.ones((self.num_envs, 2, self.single_action_space.n), np.bool_)
+            legal[:, self.view.seat] = np.asarray(self._info["action_mask"])
+            action_check.check_legal(both, legal, np.asarray(self._info["current_player"]), self.game_spec.id,
+                                     self.agents, skip=np.asarray(self._state.done))
+        return actions, unchecked
+
+    def _opponent_actions(self) -> jax.Array:
+        """A function opponent's actions for this step, from its own observation (the learner's
+        with the opponent's player plane), in the env's backend type; checked on the host."""
+        plane = self.view.other * self.core_env.config.obs_scale
+        theirs = backends.to_backend(self._obs.at[:, -1].set(np.uint8(plane)), self.backend)
+        actions = action_check.check_batch(action_check.to_host(self._opponent(theirs)), self.num_envs,
+                                           self.single_action_space.n, self.game_spec.id, "from the opponent")
+        return jax.device_put(actions.astype(np.int32), self.device)
+
+    def action_masks(self) -> np.ndarray:
+        """bool (num_envs, num_actions): the actions open to the learner now (against an opponent),
+        as sb3-contrib's MaskablePPO reads them; every action in a one-player env."""
+        if self._info is None:
+            raise gymnasium.error.ResetNeeded("call reset() before action_masks()")
+        if self.view is None:
+            return np.ones((self.num_envs, self.single_action_space.n), np.bool_)
+        return np.asarray(self._info["action_mask"])
 
     @property
     def game(self) -> str:
@@ -211,7 +273,8 @@ class OctaxVectorEnv(gymnasium.vector.VectorEnv):
         return mask
 
     def __repr__(self) -> str:
-        return f"OctaxVectorEnv({self.game_spec.id}, num_envs={self.num_envs}, backend={self.backend!r})"
+        against = "" if self.view is None else f", seat={self.view.seat}, opponent={self.view.opponent!r}"
+        return f"{type(self).__name__}({self.game_spec.id}, num_envs={self.num_envs}, backend={self.backend!r}{against})"
 
 
 # Every keyword the vector env takes: its own (the keyword-only arguments above) and the core's
