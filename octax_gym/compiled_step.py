@@ -175,7 +175,10 @@ def build(game: Any, rom, options: dict[str, Any], *, players: int = 1,
     if players == 2 and spec.seats is None:
         raise ValueError(f"{spec.id} is a one-player game; two-player games: {', '.join(list_games(players=2))}")
     config, params = octax_core.make_config(spec, autoreset=False, **options)  # checks every value
-    return _compiled_step(spec, config, None if rom is None else str(rom), players, view), params
+    rom = None if rom is None else str(rom)
+    if players == 1:  # the one-player call, as it always was
+        return _compiled_step(spec, config, rom), params
+    return _compiled_step(spec, config, rom, players, view), params
 
 
 def resolve_game(game: Union[str, GameSpec], players: int = 1) -> GameSpec:
