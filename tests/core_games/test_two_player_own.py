@@ -1,0 +1,208 @@
+"""Our own two-player games, Duel and Cycles (roms/duel.8o, roms/cycles.8o), through `make_multi`.
+
+Each seat's keys move its own side only; each seat's reward is its own score's change, and the
+two sum to zero; the scripted policies (`Seats.scripted_policy`) beat uniform random play from
+either seat; episodes end. Cycles' two halves mirror each other exactly: the mirrored actions
+give the mirrored game. One jitted rollout per game (its policies are an argument), 16 envs.
+That the committed ROMs are what the sources build is tests/core_tools/test_own_roms.py's (it
+globs roms/*.8o).
+"""
+
+from __future__ import annotations
+
+import functools
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+import pytest
+
+import octax_core
+from octax_core.env.games import cycles, duel
+
+GAMES = ["Duel", "Cycles1", "Cycles2", "Cycles3"]
+NUM_ENVS = 16
+RANDOM, SCRIPTED, NOOP = 0, 1, 2
+
+
+@functools.cache
+def _env(game_id: str):
+    return octax_core.make_multi(game_id)
+
+
+@functools.cache
+def _rollout(game_id: str, steps: int):
+    """(key, modes (2,)) -> per-step rewards (T, N, 2), done (T, N), V (T, N, 16), for NUM_ENVS
+    envs; a seat's mode is RANDOM, SCRIPTED or NOOP. Episodes are not reset once done."""
+    env, params = _env(game_id)
+    policy = env.seats.scripted_policy
+
+    def one(key, modes):
+        reset_key, run_key = jax.random.split(key)
+        _, state = env.reset(reset_key, params)
+
+        def body(carry, key):
+            state, done = carry
+            pick, step_key = jax.random.split(key)
+            random_actions = jax.random.randint(pick, (2,), 0, env.num_actions)
+            actions = jnp.stack([
+                jnp.select([modes[seat] == SCRIPTED, modes[seat] == RANDOM],
+                           [policy(state.machine, seat), random_actions[seat]], 0)
+                for seat in range(2)]).astype(jnp.int32)
+            _, new_state, rewards, terminated, truncated, _ = env.step_env(step_key, state, actions, params)
+            new_state = jax.tree.map(lambda new, old: jnp.where(done, old, new), new_state, state)
+            rewards = jnp.where(done, 0.0, rewards)
+            done = done | terminated | truncated
+            return (new_state, done), (rewards, done, new_state.machine.V)
+
+        return jax.lax.scan(body, (state, jnp.bool_(False)), jax.random.split(run_key, steps))[1]
+
+    run = jax.jit(jax.vmap(one, in_axes=(0, None)))
+    return lambda seed, modes: tuple(np.asarray(x).swapaxes(0, 1) for x in run(
+        jax.random.split(jax.random.key(seed), NUM_ENVS), jnp.asarray(modes)))
+
+
+STEPS = {"Duel": 900, "Cycles1": 600, "Cycles2": 600, "Cycles3": 600}
+
+
+@functools.cache
+def _play(game_id: str, modes: tuple[int, int], seed: int = 0):
+    return _rollout(game_id, STEPS[game_id])(seed, modes)
+
+
+def test_the_two_player_games_are_listed_and_solo():
+    two = octax_core.list_games(players=2)
+    for game_id in GAMES + ["Cycles"]:
+        spec = octax_core.get_spec(game_id)
+        assert game_id in two and game_id in octax_core.list_games(suite="ours")
+        assert spec.solo and spec.seats.zero_sum and spec.action_keys == spec.seats.action_keys[0]
+        assert not set(spec.seats.action_keys[0]) & set(spec.seats.action_keys[1])
+    assert octax_core.get_spec("Cycles").startup == octax_core.get_spec("Cycles2").startup
+
+
+@pytest.mark.parametrize("game_id", ["Duel", "Cycles1"])
+def test_solo_env_is_player_1_against_an_idle_player_2(game_id):
+    env, params = octax_core.make(game_id)
+    assert env.num_actions == _env(game_id)[0].num_actions
+    _, state = env.reset(jax.random.key(0), params)
+    step = jax.jit(env.step_env)
+    total = 0.0
+    for t in range(300):
+        _, state, reward, *_ = step(jax.random.key(t), state, jnp.int32(t % env.num_actions), params)
+        total += float(reward)
+    assert total == int(state.machine.V[5])  # player 1's points
+
+
+# --- each seat's keys move its own side ---------------------------------------------------------
+
+
+@functools.cache
+def _step(game_id: str):
+    return jax.jit(_env(game_id)[0].step_env)
+
+
+def _after(game_id: str, actions, warmup: int, steps: int):
+    env, params = _env(game_id)
+    step = _step(game_id)
+    _, state = env.reset(jax.random.key(3), params)
+    for t in range(warmup + steps):
+        act = jnp.array(actions if t >= warmup else (0, 0), jnp.int32)
+        _, state, *_ = step(jax.random.key(t), state, act, params)
+    return np.asarray(state.machine.V).astype(int)
+
+
+def test_duel_keys_move_their_own_paddle_only():
+    # the serve's pause: the ball waits at the centre while the paddles move (20 frames)
+    base = _after("Duel", (0, 0), 6, 4)
+    p1_up, p2_down = _after("Duel", (1, 0), 6, 4), _after("Duel", (0, 2), 6, 4)
+    assert p1_up[duel.PAD1] < base[duel.PAD1] and p1_up[duel.PAD2] == base[duel.PAD2]
+    assert p2_down[duel.PAD2] > base[duel.PAD2] and p2_down[duel.PAD1] == base[duel.PAD1]
+
+
+@pytest.mark.parametrize("action, heading", [(1, cycles.UP), (2, cycles.DOWN)])
+def test_cycles_keys_steer_their_own_cycle_only(action, heading):
+    base = _after("Cycles1", (0, 0), 20, 3)
+    assert (base[cycles.DIR1], base[cycles.DIR2]) == (cycles.RIGHT, cycles.LEFT)
+    first = _after("Cycles1", (action, 0), 20, 3)
+    second = _after("Cycles1", (0, action), 20, 3)
+    assert (first[cycles.DIR1], first[cycles.DIR2]) == (heading, cycles.LEFT)
+    assert (second[cycles.DIR1], second[cycles.DIR2]) == (cycles.RIGHT, heading)
+
+
+def test_cycles_ignores_the_way_back():
+    back = _after("Cycles1", (3, 4), 20, 3)  # player 1 left, player 2 right: both reversals
+    assert (back[cycles.DIR1], back[cycles.DIR2]) == (cycles.RIGHT, cycles.LEFT)
+
+
+# --- rewards --------------------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("game_id", GAMES)
+@pytest.mark.parametrize("modes", [(SCRIPTED, RANDOM), (RANDOM, SCRIPTED)])
+def test_rewards_are_each_seats_own_points_and_zero_sum(game_id, modes):
+    rewards, done, V = _play(game_id, modes)
+    points = V[..., 5].astype(int) - V[..., 6].astype(int)  # player 1's lead
+    lead = np.concatenate([np.zeros((1, NUM_ENVS), int), points])
+    np.testing.assert_array_equal(rewards[..., 0], np.diff(lead, axis=0))
+    np.testing.assert_array_equal(rewards.sum(-1), 0)
+    assert set(np.unique(rewards)) <= {-1.0, 0.0, 1.0}
+    assert (rewards != 0).any()
+
+
+# --- the scripted policy beats random; episodes end -----------------------------------------------
+
+
+@pytest.mark.parametrize("game_id", GAMES)
+def test_scripted_policy_beats_random_from_either_seat(game_id):
+    for seat, modes in ((0, (SCRIPTED, RANDOM)), (1, (RANDOM, SCRIPTED))):
+        rewards, done, V = _play(game_id, modes)
+        returns = rewards.sum(0)[:, seat]
+        assert (returns > 0).mean() >= 0.9 and returns.mean() >= 4, (game_id, seat, returns)
+        assert (returns[done[-1]] == (duel.WIN if game_id == "Duel" else cycles.WIN)).mean() >= 0.9
+
+
+@pytest.mark.parametrize("game_id", GAMES)
+def test_random_play_is_even_and_episodes_end(game_id):
+    rewards, done, V = _play(game_id, (RANDOM, RANDOM))
+    assert done[-1].mean() >= 0.8, f"{game_id}: {done[-1].mean():.2f} of the random episodes ended"
+    returns = rewards.sum(0)
+    assert abs(returns[:, 0].mean()) < 2.5  # zero-sum, symmetric: even on average
+    ended = V[-1, done[-1]]
+    assert (np.maximum(ended[:, 5], ended[:, 6]) == (duel.WIN if game_id == "Duel" else cycles.WIN)).all()
+    assert (ended[:, 14] == 1).all()
+
+
+# --- Cycles' halves mirror each other ---------------------------------------------------------------
+
+_MIRROR = np.array([0, 1, 2, 4, 3])  # actions: no-op, up, down, left <-> right
+
+
+def test_cycles_mirrored_actions_give_the_mirrored_game():
+    """Player 1's actions as player 2's, left and right swapped, and the other way round: the same
+    match, mirrored: every round has the other winner, and where the cycles crashed mirrors too.
+    (Within a move the ROM updates player 1 a few instructions before player 2, so a step may end
+    between the two: the comparison is per round, not per step.)"""
+    env, params = _env("Cycles3")
+    step = jax.jit(jax.vmap(env.step_env, in_axes=(0, 0, 0, None)))
+    keys = jax.random.split(jax.random.key(5), NUM_ENVS)
+    _, state = jax.vmap(env.reset, in_axes=(0, None))(keys, params)
+    mirrored = state
+    actions = np.random.default_rng(0).integers(0, env.num_actions, (300, NUM_ENVS, 2))
+    heading = np.array([cycles.UP, cycles.RIGHT, cycles.LEFT, cycles.DOWN])  # left <-> right
+    events, other_events = [[] for _ in range(NUM_ENVS)], [[] for _ in range(NUM_ENVS)]
+    for t, act in enumerate(actions):
+        step_keys = jax.random.split(jax.random.key(t), NUM_ENVS)
+        _, state, rewards, *_ = step(step_keys, state, jnp.asarray(act, jnp.int32), params)
+        _, mirrored, other, *_ = step(step_keys, mirrored, jnp.asarray(_MIRROR[act[:, ::-1]], jnp.int32), params)
+        V, W = np.asarray(state.machine.V).astype(int), np.asarray(mirrored.machine.V).astype(int)
+        for i in np.flatnonzero(np.asarray(rewards)[:, 0]):
+            events[i].append((float(rewards[i, 0]), V[i, cycles.X1], V[i, cycles.X2], V[i, cycles.Y1],
+                              V[i, cycles.Y2], V[i, cycles.DIR1], V[i, cycles.DIR2]))
+        for i in np.flatnonzero(np.asarray(other)[:, 0]):
+            other_events[i].append((-float(other[i, 0]), 31 - W[i, cycles.X2], 31 - W[i, cycles.X1],
+                                    W[i, cycles.Y2], W[i, cycles.Y1], heading[W[i, cycles.DIR2]],
+                                    heading[W[i, cycles.DIR1]]))
+    for i in range(NUM_ENVS):  # a round ending on the last step may be scored a step apart
+        shared = min(len(events[i]), len(other_events[i]))
+        assert abs(len(events[i]) - len(other_events[i])) <= 1 and events[i][:shared] == other_events[i][:shared], i
+    assert sum(map(len, events)) > NUM_ENVS  # rounds were won and lost (not only drawn)
