@@ -157,3 +157,21 @@ def test_config_checks():
     with pytest.raises(ValueError, match="even"):
         sp.Config(eval_envs=3).check()
     assert sp.Config().batch_size == 2 * sp.Config().num_envs * sp.Config().num_steps
+
+
+def test_closed_actions_are_never_played():
+    """Turn-based games: the seat not to move has only no-op open; masked logits and the random
+    player never pick a closed action."""
+    legal = jnp.array([[True, True, False, True], [True, False, False, False]] * 8)
+    logits = jnp.zeros((16, 4)).at[:, 2].set(50.0)  # the network wants the closed action
+    keys = jax.random.split(jax.random.key(0), 64)
+    for key in keys:
+        played = jax.random.categorical(key, sp.masked_logits(logits, legal))
+        assert bool(legal[jnp.arange(16), played].all())
+        played = sp.random_player(None, key, None, None, None, legal)
+        assert bool(legal[jnp.arange(16), played].all())
+    tiny = Tiny(4)
+    params = tiny.init(jax.random.key(1), jnp.zeros((1, 5, 32, 64), jnp.uint8))
+    greedy = sp.network_player(tiny, greedy=True)(params, keys[0], jnp.ones((16, 5, 32, 64), jnp.uint8), None,
+                                                  None, legal)
+    assert bool(legal[jnp.arange(16), greedy].all())
