@@ -29,7 +29,7 @@ its compilations.
 from __future__ import annotations
 
 import functools
-from typing import Any, Optional, Union
+from typing import Any, Optional
 
 import jax
 import jax.numpy as jnp
@@ -38,11 +38,10 @@ from gymnasium.vector import AutoresetMode
 
 import octax_core
 from octax_core.env import ENV_OPTIONS, Env, EnvConfig, EnvParams, EnvState, GameSpec
-from octax_core.env.games import get_spec, list_games
+from octax_core.env.games import list_games
 from octax_core.env.multi import MultiEnv
 from octax_gym import action_check, opponent
-from octax_gym.choices import UnknownOptionError
-from octax_gym.game_names import env_id, resolve_spec
+from octax_gym.game_names import resolve_spec
 
 # What the Gymnasium envs pass to the core: every env option but `autoreset`, which Gymnasium's
 # own `autoreset_mode` replaces.
@@ -162,7 +161,7 @@ def _compiled_step(spec: GameSpec, config: EnvConfig, rom: Optional[str], player
 
 def build(game: Any, rom, options: dict[str, Any], *, players: int = 1,
           view: Optional[opponent.View] = None) -> tuple[CompiledStep, EnvParams]:
-    """The cached compiled step and checked params for a game (any name `resolve_game` takes, or a
+    """The cached compiled step and checked params for a game (any name `resolve_spec` takes, or a
     `GameSpec`) and `GYM_ENV_OPTIONS` keywords (None means the game's default).
 
     `players=2` builds the two-player env (`octax_core.make_multi`), seen from one seat against
@@ -171,7 +170,7 @@ def build(game: Any, rom, options: dict[str, Any], *, players: int = 1,
     Raises:
         ValueError: `players=2` for a one-player game (the message lists the two-player ones).
     """
-    spec = resolve_game(game, players)
+    spec = resolve_spec(game, players)
     if players == 2 and spec.seats is None:
         raise ValueError(f"{spec.id} is a one-player game; two-player games: {', '.join(list_games(players=2))}")
     config, params = octax_core.make_config(spec, autoreset=False, **options)  # checks every value
@@ -179,30 +178,6 @@ def build(game: Any, rom, options: dict[str, Any], *, players: int = 1,
     if players == 1:  # the one-player call, as it always was
         return _compiled_step(spec, config, rom), params
     return _compiled_step(spec, config, rom, players, view), params
-
-
-def resolve_game(game: Union[str, GameSpec], players: int = 1) -> GameSpec:
-    """`game_names.resolve_spec`, plus the two-player games that are not one-player envs
-    (`GameSpec.solo` False), which `list_games()` leaves out: "Tank", "octax/Tank-v0", any case.
-
-    Raises:
-        TypeError, UnknownOptionError: as `resolve_spec`; with `players=2` the message lists the
-        two-player games.
-    """
-    if isinstance(game, GameSpec) or not isinstance(game, str):
-        return resolve_spec(game)
-    two = list_games(players=2)
-    names = {name: name for name in two} | {env_id(name): name for name in two}
-    found = names.get(game) or {name.lower(): game_id for name, game_id in names.items()}.get(game.lower())
-    if found is not None:
-        return get_spec(found)
-    try:
-        return resolve_spec(game)
-    except UnknownOptionError:
-        if players == 1:
-            raise
-    raise UnknownOptionError("two-player game", game, two, f"or their Gymnasium ids ({env_id(two[0])}, ...)"
-                             if two else "", near=names)
 
 
 def seeds_for(seed, num_envs: int) -> list[int]:

@@ -23,14 +23,17 @@ def env_id(game: Union[str, GameSpec]) -> str:
     return f"{NAMESPACE}/{spec.id}-v{spec.version}"
 
 
-def resolve_spec(game: Union[str, GameSpec]) -> GameSpec:
+def resolve_spec(game: Union[str, GameSpec], players: int = 1) -> GameSpec:
     """The registered game a name means: its id or Gymnasium id, exact first, then in any case.
 
-    A `GameSpec` is taken as it is (your own game, `register_game`).
+    Every registered game resolves, the two-player games that are not one-player envs too (a
+    one-player env of one refuses it by name: it needs an opponent). A `GameSpec` is taken as it
+    is (your own game, `register_game`).
 
     Raises:
         TypeError: neither a str nor a GameSpec.
-        UnknownOptionError: no game goes by that name; the message lists every id.
+        UnknownOptionError: no game goes by that name; the message lists every id (with
+            `players=2`, every two-player id).
     """
     if isinstance(game, GameSpec):
         return game
@@ -39,9 +42,9 @@ def resolve_spec(game: Union[str, GameSpec]) -> GameSpec:
     names = _names()
     found = names.get(game) or {name.lower(): game_id for name, game_id in names.items()}.get(game.lower())
     if found is None:
-        games = list_games()
+        games = list_games(players=players)
         also = f"or their Gymnasium ids ({env_id(games[0])}, ...)" if games else ""
-        raise UnknownOptionError("game", game, games, also, near=names)
+        raise UnknownOptionError("game" if players == 1 else "two-player game", game, games, also, near=names)
     return get_spec(found)
 
 
@@ -57,5 +60,5 @@ def resolve_env_id(game: Union[str, GameSpec]) -> str:
 
 def _names() -> dict[str, str]:
     """Every accepted exact name -> the registry id (read per call: games may be registered late)."""
-    games = list_games()
+    games = sorted(set(list_games()) | set(list_games(players=2)))
     return {game: game for game in games} | {env_id(game): game for game in games}

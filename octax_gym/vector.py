@@ -31,6 +31,7 @@ from octax_core.env.config import check_option_names
 from octax_core.validate import check_int
 from octax_gym.choices import UnknownOptionError, check_choice, check_names
 from octax_gym.compiled_step import GYM_ENV_OPTIONS, build, keys_from_seeds, seeds_for
+from octax_gym.game_names import resolve_spec
 
 FRAMES_PER_SECOND = 60  # the timer rate, on all three platforms; a step lasts frames_per_step frames
 RENDER_MODES = (None, "rgb_array")
@@ -126,7 +127,7 @@ class OctaxVectorEnv(gymnasium.vector.VectorEnv):
             self.palette = render.resolve_palette(palette)  # a bad one raises before the build
         view = self._opponent = None
         if players == 1:
-            spec = compiled_step.resolve_game(game)
+            spec = resolve_spec(game)
             view, self._opponent = opponents.resolve(opponent, seat, spec)
             if view is not None:
                 players, game = 2, spec

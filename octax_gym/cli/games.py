@@ -22,7 +22,7 @@ def add_commands(commands: argparse._SubParsersAction) -> None:
                                             "present and verified.")
     games.add_argument("--category", help="only this category (planning, timing, resources, "
                                           "navigation, reaction)")
-    games.add_argument("--suite", help="only this suite (octax: the paper's games; ours: Dodge, Flak)")
+    games.add_argument("--suite", help="only this suite (octax: the paper's games; ours: Dodge, Flak, Duel, Cycles)")
     games.set_defaults(func=_cmd_list)
     info = commands.add_parser("info", help="one game: actions, spaces, quirks, timers, ROM",
                                description="Everything a game's spec says, without running it.")

@@ -18,7 +18,8 @@ PAPER_IDS = (
     + [f"TargetShooter{i}" for i in range(1, 4)]
 )
 # Our own games (roms/*.8o), each in three levels plus the plain id (its middle level).
-OWN_IDS = ["Dodge", "Dodge1", "Dodge2", "Dodge3", "Flak", "Flak1", "Flak2", "Flak3"]
+OWN_IDS = ["Cycles", "Cycles1", "Cycles2", "Cycles3", "Dodge", "Dodge1", "Dodge2", "Dodge3", "Duel", "Flak", "Flak1",
+           "Flak2", "Flak3"]
 EXPECTED_IDS = sorted(PAPER_IDS + OWN_IDS)
 # test_games_levels.py plays Cavern1, SpaceFlight1 and TargetShooter1 at random; these are the others.
 OTHER_LEVELS = [g for g in EXPECTED_IDS if g.startswith(("Cavern", "SpaceFlight", "TargetShooter"))

@@ -17,7 +17,7 @@ from octax_core.env.games.spec import (CATEGORIES, GameSpec, Seats, bcd_value, i
 
 SUITES = {
     "octax": "the octax paper's suite: 21 classic CHIP-8 titles and their levels",
-    "ours": "octax-gym's own games, written in Octo (roms/*.8o): Dodge and Flak, by level",
+    "ours": "octax-gym's own games, written in Octo (roms/*.8o): Dodge and Flak, by level; Duel and Cycles, for two",
     "archive": "games of the Chip8 Community Archive (CC0, shipped in the package): Octojam entries and "
                "others, CHIP-8, SUPER-CHIP and XO-CHIP",
 }
