@@ -44,6 +44,14 @@ from octax_core.env.games import GameSpec, get_spec, list_games
 
 GAME_STREAM = 0x6A4D  # folded into a reset's key to draw the game, so the start draw is make()'s
 
+# Named mixes. octax16: sixteen of the octax paper's titles, as many as its training figure
+# has: the ten its text discusses (Airplane, Blinky, Brix, Deep8, Filter, Pong, Tank, Tetris,
+# VerticalBrix, Worm) and the other six single-level titles that are not exploration games.
+MIXES: dict[str, tuple[str, ...]] = {
+    "octax16": ("Airplane", "Blinky", "Brix", "Deep8", "Filter", "Missile", "Pong", "Rocket", "ShootingStars",
+                "Squash", "Submarine", "Tank", "Tetris", "UFO", "VerticalBrix", "Worm"),
+}
+
 
 class MixEnv(Env):
     """Envs that each play one of `specs`, stepped as one program. See the module docstring."""
@@ -184,7 +192,8 @@ def make_mix(games: Sequence[Union[str, GameSpec]], weights: Optional[Sequence[f
     """One env over several games: each env of a batch plays one of `games` (see the module docstring).
 
     Args:
-        games: registered ids (`list_games()`) and/or your own `GameSpec`s, all of one platform.
+        games: registered ids (`list_games()`) and/or your own `GameSpec`s, all of one platform;
+            or the name of a mix in `MIXES` ("octax16").
         weights: how often a reset draws each game (normalised); uniform by default.
         roms: explicit ROM paths, one per game (None entries: the ROM store's).
         **options: `make`'s options, applied to every game (`ENV_OPTIONS`); one left out takes each
@@ -195,8 +204,11 @@ def make_mix(games: Sequence[Union[str, GameSpec]], weights: Optional[Sequence[f
             roms that do not match the games. KeyError: an unknown game id (the message lists
             the valid ones). TypeError: an unknown option.
     """
+    if isinstance(games, str) and games in MIXES:
+        games = MIXES[games]
     if isinstance(games, (str, GameSpec)) or not len(games):
-        raise ValueError(f"make_mix needs a non-empty list of games; valid ids: {', '.join(list_games())}")
+        raise ValueError(f"make_mix needs a non-empty list of games or a named mix ({', '.join(MIXES)}); "
+                         f"valid ids: {', '.join(list_games())}")
     specs = [game if isinstance(game, GameSpec) else get_spec(game) for game in games]
     platforms = sorted({spec.platform for spec in specs})
     if len(platforms) > 1:
