@@ -12,16 +12,16 @@ The names below are the public API. See docs/machine.md (the machine) and docs/e
 
 from octax_core.emulator import (FONT, FONT_ADDRESS, MAX_ROM_SIZE, PLATFORMS, PROGRAM_ADDRESS, QUIRK_PROFILES, Kind,
                                  Machine, MachineState, Platform, Quirks, Rom, poke, render_text, snapshot)
-from octax_core.env import (Env, EnvConfig, EnvParams, EnvState, GameSpec, MultiEnv, Seats, get_spec, list_games, make,
-                            make_config, make_multi, make_params)
+from octax_core.env import (Env, EnvConfig, EnvParams, EnvState, GameSpec, MixEnv, MultiEnv, Seats, get_spec, list_games,
+                            make, make_config, make_mix, make_multi, make_params)
 from octax_core.env.testing import check_env
 from octax_core.tools.octo import AssemblyError, assemble
 
 __all__ = [
     "AssemblyError", "FONT", "FONT_ADDRESS", "Env", "EnvConfig", "EnvParams", "EnvState", "GameSpec", "Kind",
-    "MAX_ROM_SIZE", "Machine", "MachineState", "MultiEnv", "Seats", "PLATFORMS", "PROGRAM_ADDRESS", "Platform", "QUIRK_PROFILES",
+    "MAX_ROM_SIZE", "Machine", "MachineState", "MixEnv", "MultiEnv", "Seats", "PLATFORMS", "PROGRAM_ADDRESS", "Platform", "QUIRK_PROFILES",
     "Quirks", "Rom",
-    "assemble", "check_env", "disassemble", "get_spec", "list_games", "make", "make_config", "make_multi", "make_params", "poke",
+    "assemble", "check_env", "disassemble", "get_spec", "list_games", "make", "make_config", "make_mix", "make_multi", "make_params", "poke",
     "render_text", "snapshot",
 ]
 

@@ -28,7 +28,7 @@ from octax_core.emulator import cpu, idle
 from octax_core.emulator.gate import _batch
 from octax_core.emulator.opcodes import Kind
 from octax_core.emulator.platforms import Platform
-from octax_core.emulator.quirks import Quirks
+from octax_core.emulator.quirks import Quirks, lane_quirks
 from octax_core.emulator.state import shown
 
 
@@ -53,37 +53,57 @@ class Loop(NamedTuple):
     record_screens: bool
     skip_idle: bool
     chunk: int  # instructions per loop step: the whole frame without idle skipping
+    # A mix of games (`Machine(profiles=...)`): (quirks, instructions per frame) per profile; each
+    # machine runs the one its profile index picks, and `quirks` and `instructions_per_frame`
+    # above are then unused (the largest instructions per frame sizes the chunks).
+    profiles: tuple[tuple[Quirks, int], ...] = ()
 
-    def execute(self, state, keys, stalled):
-        return cpu.execute(self.platform, self.quirks, state, keys, stalled)
+    def lane(self, profile):
+        """(quirks, instructions per frame) of the machine running `profile`: the loop's own for
+        one profile; for a mix, what the profiles share as constants and the rest looked up."""
+        if not self.profiles:
+            return self.quirks, self.instructions_per_frame
+        quirks = lane_quirks([q for q, _ in self.profiles], profile)
+        speeds = [ipf for _, ipf in self.profiles]
+        if len(set(speeds)) == 1:
+            return quirks, speeds[0]
+        return quirks, jnp.asarray(speeds, jnp.int32)[profile]
 
 
-def _start(loop: Loop, state, halted) -> Clock:
+def _start(loop: Loop, state, halted, profile) -> Clock:
     """The clock of a machine at the call's start; a halted machine, or one after 00FD, is done."""
+    instructions_per_frame = loop.lane(profile)[1]
     still = halted | state.exited
     zero = jnp.zeros_like(state.pc, dtype=jnp.int32)
     picture = shown(state)
     screens = jnp.zeros((loop.frames if loop.record_screens else 1, *picture.shape), picture.dtype)
     return Clock(frame=jnp.where(still, loop.frames, 0).astype(jnp.int32), count=zero,
-                 target=zero + loop.instructions_per_frame, detector=idle.start(state, loop.skip_idle),
+                 target=zero + instructions_per_frame, detector=idle.start(state, loop.skip_idle),
                  recorded=zero, screens=screens)
 
 
-def _chunk(loop: Loop, keys, state, clock: Clock):
+def _chunk(loop: Loop, keys, state, clock: Clock, profile):
     """Up to `loop.chunk` instructions of one machine: each runs while its frame goes on (count
     below the target, no display wait or exit yet), else it is a STALL. Returns the state, the
     count, whether the frame is over, and whether any instruction wrote memory or the screen."""
     frame_going = clock.frame < loop.frames
+    quirks, instructions_per_frame = loop.lane(profile)
+    # Without skipping a chunk is the frame, and the count cannot reach the target early, unless
+    # the machines of a mix run frames of different lengths.
+    counted = loop.skip_idle or not isinstance(instructions_per_frame, int)
 
     def instruction(carry, _):
         state, count, over, dirty = carry
         stalled = over | ~frame_going
-        if loop.skip_idle:  # without skipping, a chunk is the frame: the count cannot reach the target early
+        if counted:
             stalled = stalled | (count >= clock.target)
-        state, kind = loop.execute(state, keys, stalled)
+        state, kind = cpu.execute(loop.platform, quirks, state, keys, stalled)
         count = count + jnp.where(stalled, 0, 1)
-        if loop.quirks.display_wait:  # the VIP's DXYN waits for the next vertical blank: the frame is over
+        # The VIP's DXYN waits for the next vertical blank: the frame is over.
+        if quirks.display_wait is True:
             over = over | (kind == Kind.DRW)
+        elif quirks.display_wait is not False:  # a mix of profiles: each machine's own answer
+            over = over | (quirks.display_wait & (kind == Kind.DRW))
         if state.extension is not None:  # 00FD: this frame ends here; later ones do nothing
             over = over | state.extension.exited
         if loop.skip_idle:
@@ -96,20 +116,20 @@ def _chunk(loop: Loop, keys, state, clock: Clock):
     return state, count, over, dirty
 
 
-def _step(loop: Loop, keys, carry):
+def _step(loop: Loop, keys, profile, carry):
     """One loop step of one machine: a chunk of instructions, then (with idle skipping) the cycle
     check. Returns the state, the clock and whether the machine's frame has ended."""
     state, clock = carry
     running = clock.frame < loop.frames
-    state, count, over, dirty = _chunk(loop, keys, state, clock)
+    state, count, over, dirty = _chunk(loop, keys, state, clock, profile)
     if not loop.skip_idle:
         return state, clock._replace(count=count), running
-    target, detector = idle.detect(clock.detector, state, count, dirty, clock.target, loop.instructions_per_frame)
+    target, detector = idle.detect(clock.detector, state, count, dirty, clock.target, loop.lane(profile)[1])
     clock = clock._replace(count=count, target=target, detector=detector)
     return state, clock, running & (over | (count >= target))
 
 
-def _end_frame(loop: Loop, ended, state, clock: Clock):
+def _end_frame(loop: Loop, profile, ended, state, clock: Clock):
     """Where `ended`: the timer tick, the picture recorded, and a fresh clock for the next frame.
     `state` comes without its memory, which no frame's end touches, so that a `lax.cond` around
     this never copies it."""
@@ -124,14 +144,14 @@ def _end_frame(loop: Loop, ended, state, clock: Clock):
     return state, Clock(
         frame=frame,
         count=jnp.where(ended, 0, clock.count),
-        target=jnp.where(ended, loop.instructions_per_frame, clock.target),
+        target=jnp.where(ended, loop.lane(profile)[1], clock.target),
         detector=idle.restart(clock.detector, state, ended) if loop.skip_idle else clock.detector,
         recorded=jnp.where(ended, clock.frame + 1, clock.recorded),
         screens=screens,
     )
 
 
-def _loop_body(loop: Loop, batched: bool, keys, carry):
+def _loop_body(loop: Loop, batched: bool, keys, profile, carry):
     """A step for every machine, then the frames' ends. With idle skipping most steps end no
     frame, so the ends run inside a `lax.cond` (one branch on a flag); without, every step
     ends every running machine's frame."""
@@ -139,7 +159,8 @@ def _loop_body(loop: Loop, batched: bool, keys, carry):
     end = functools.partial(_end_frame, loop)
     if batched:
         step, end = jax.vmap(step), jax.vmap(end)
-    state, clock, ended = step(keys, carry)
+    end = functools.partial(end, profile)
+    state, clock, ended = step(keys, profile, carry)
     light = state.replace(memory=None)
     if loop.skip_idle:
         light, clock = jax.lax.cond(jnp.any(ended), end, lambda e, s, c: (s, c), ended, light, clock)
@@ -159,32 +180,35 @@ def _finish(state, clock: Clock, record_screens: bool):
 
 @functools.lru_cache(maxsize=None)
 def frame_runner(platform: Platform, quirks: Quirks, instructions_per_frame: int, frames: int,
-                 record_screens: bool, skip_idle: bool, chunk: Optional[int] = None):
-    """`run(state, keys, halted) -> (state, screens or None)`: `frames` frames of one machine;
-    batch it with `jax.vmap` (its batching rule is the lockstep loop over every machine, see the
-    module docstring). A `halted` machine (bool), like one after 00FD, does nothing this call:
-    its state comes back unchanged. `skip_idle` skips idle instructions (`idle`), in chunks of
-    `chunk` instructions (`idle.chunk_size` by default)."""
+                 record_screens: bool, skip_idle: bool, chunk: Optional[int] = None,
+                 profiles: tuple[tuple[Quirks, int], ...] = ()):
+    """`run(state, keys, halted, profile) -> (state, screens or None)`: `frames` frames of one
+    machine; batch it with `jax.vmap` (its batching rule is the lockstep loop over every machine,
+    see the module docstring). A `halted` machine (bool), like one after 00FD, does nothing this
+    call: its state comes back unchanged. `skip_idle` skips idle instructions (`idle`), in chunks
+    of `chunk` instructions (`idle.chunk_size` by default). With `profiles` (a mix of games, each
+    machine its own quirks and speed), `profile` (int32) is the machine's index into them and
+    `instructions_per_frame` their largest; without, `profile` is unused."""
     if skip_idle:
         chunk = idle.chunk_size(instructions_per_frame) if chunk is None else min(chunk, instructions_per_frame)
     else:
         chunk = instructions_per_frame
-    loop = Loop(platform, quirks, instructions_per_frame, frames, record_screens, skip_idle, chunk)
+    loop = Loop(platform, quirks, instructions_per_frame, frames, record_screens, skip_idle, chunk, profiles)
 
     @jax.custom_batching.custom_vmap
-    def run(state, keys, halted):
-        carry = (state, _start(loop, state, halted))
+    def run(state, keys, halted, profile):
+        carry = (state, _start(loop, state, halted, profile))
         state, clock = jax.lax.while_loop(lambda c: c[1].frame < frames,
-                                          functools.partial(_loop_body, loop, False, keys), carry)
+                                          functools.partial(_loop_body, loop, False, keys, profile), carry)
         return _finish(state, clock, record_screens)
 
     @run.def_vmap
-    def run_batched(axis_size, in_batched, state, keys, halted):
-        state, keys, halted = (_batch(tree, batched, axis_size)
-                               for tree, batched in zip((state, keys, halted), in_batched))
-        carry = (state, jax.vmap(functools.partial(_start, loop))(state, halted))
+    def run_batched(axis_size, in_batched, state, keys, halted, profile):
+        state, keys, halted, profile = (_batch(tree, batched, axis_size)
+                                        for tree, batched in zip((state, keys, halted, profile), in_batched))
+        carry = (state, jax.vmap(functools.partial(_start, loop))(state, halted, profile))
         state, clock = jax.lax.while_loop(lambda c: jnp.any(c[1].frame < frames),
-                                          functools.partial(_loop_body, loop, True, keys), carry)
+                                          functools.partial(_loop_body, loop, True, keys, profile), carry)
         out = jax.vmap(lambda s, c: _finish(s, c, record_screens))(state, clock)
         return out, jax.tree.map(lambda _: True, out)
 

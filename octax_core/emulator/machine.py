@@ -18,7 +18,7 @@ import jax.numpy as jnp
 from octax_core.emulator import cpu, frame, idle
 from octax_core.emulator.keypad import keys_to_mask
 from octax_core.emulator.platforms import Platform, check_program_fits, resolve_platform
-from octax_core.emulator.quirks import Quirks, resolve_quirks
+from octax_core.emulator.quirks import Quirks, lane_quirks, resolve_quirks
 from octax_core.emulator.rom import Rom, RomLike
 from octax_core.emulator.state import MachineState, boot_state
 from octax_core.validate import check_bool, check_int
@@ -42,6 +42,13 @@ class Machine:
             Bit-identical to running every instruction; False runs every one, in lockstep. It
             takes effect from `idle.SKIP_FROM` (25) instructions per frame: a shorter frame has
             too little to skip for the clock's bookkeeping to pay, and runs plain.
+        profiles: for a batch whose machines run different games (`octax_core.make_mix`): one
+            (quirks, instructions_per_frame) pair per game, each machine running the one its
+            `profile` index picks (`run_frames(..., profile=i)`); quirks the profiles share stay
+            constants of the traced program, the others are looked up per machine. `quirks` and
+            `instructions_per_frame` are then the first profile's and the largest; every
+            profile's quirks must be given as a `Quirks` or a profile name. Empty (the default):
+            one profile, the one above.
 
     Example:
         >>> import jax, octax_core
@@ -56,10 +63,17 @@ class Machine:
     quirks: Union[Quirks, str, None] = None
     instructions_per_frame: int = 11
     skip_idle: bool = True
+    profiles: tuple[tuple[Union[Quirks, str], int], ...] = ()
 
     def __post_init__(self):
         platform = resolve_platform(self.platform)
         object.__setattr__(self, "platform", platform)
+        if self.profiles:
+            profiles = tuple((resolve_quirks(quirks), check_int("instructions_per_frame", ipf))
+                             for quirks, ipf in self.profiles)
+            object.__setattr__(self, "profiles", profiles)
+            object.__setattr__(self, "quirks", profiles[0][0])
+            object.__setattr__(self, "instructions_per_frame", max(ipf for _, ipf in profiles))
         object.__setattr__(self, "quirks", resolve_quirks(platform.default_quirks if self.quirks is None else self.quirks))
         object.__setattr__(self, "instructions_per_frame",
                            check_int("instructions_per_frame", self.instructions_per_frame))
@@ -78,13 +92,17 @@ class Machine:
         check_program_fits(len(rom.data), rom.name, self.platform)
         return boot_state(rom, key, self.platform)
 
-    def execute(self, state: MachineState, keys) -> MachineState:
-        """Runs exactly one instruction (no timer tick, no display wait; after 00FD, nothing)."""
+    def execute(self, state: MachineState, keys, *, profile=None) -> MachineState:
+        """Runs exactly one instruction (no timer tick, no display wait; after 00FD, nothing);
+        `profile` as for `run_frames`."""
         stalled = None if state.extension is None else state.extension.exited
-        new_state, _ = cpu.execute(self.platform, self.quirks, state, keys_to_mask(keys), stalled)
+        quirks = self.quirks if not self.profiles else lane_quirks([q for q, _ in self.profiles],
+                                                                    self._profile(profile))
+        new_state, _ = cpu.execute(self.platform, quirks, state, keys_to_mask(keys), stalled)
         return new_state
 
-    def run_frames(self, state: MachineState, keys, frames, *, halted=None, record_screens: bool = False):
+    def run_frames(self, state: MachineState, keys, frames, *, halted=None, record_screens: bool = False,
+                   profile=None):
         """Runs `frames` 60 Hz frames with `keys` held throughout: the one frame loop.
 
         Args:
@@ -96,6 +114,8 @@ class Machine:
             halted: optional bool scalar; where true nothing runs, the timers do not tick and
                 the state comes back unchanged (the env halts episodes that have ended).
             record_screens: also return the packed picture after each frame (`state.display`).
+            profile: with `profiles`, the machine's index into them (an int or int32 scalar,
+                traced or not); required then, and refused without.
 
         Returns:
             The state after the frames; with `record_screens`, `(state, screens)` where screens
@@ -109,13 +129,29 @@ class Machine:
         """
         mask = keys_to_mask(keys)
         halted = jnp.zeros_like(state.pc, dtype=jnp.bool_) if halted is None else jnp.asarray(halted, jnp.bool_)
+        profile = self._profile(profile)
         if isinstance(frames, jax.Array) and not record_screens:
             _check_traced_frames(frames)
             one = self._runner(1, False)
-            return jax.lax.fori_loop(0, frames, lambda _, state: one(state, mask, halted)[0], state)
+            return jax.lax.fori_loop(0, frames, lambda _, state: one(state, mask, halted, profile)[0], state)
         frames = _check_static_frames(frames, record_screens)
-        state, screens = self._runner(frames, record_screens)(state, mask, halted)
+        state, screens = self._runner(frames, record_screens)(state, mask, halted, profile)
         return (state, screens) if record_screens else state
+
+    def _profile(self, profile) -> jax.Array:
+        """The machine's profile index as int32 (0, unused, for a machine of one profile)."""
+        if not self.profiles:
+            if profile is not None:
+                raise ValueError("profile= is for a Machine with profiles (a mix of games); this one has one profile")
+            return jnp.int32(0)
+        if profile is None:
+            raise ValueError(f"this Machine runs {len(self.profiles)} profiles: give run_frames/execute "
+                             f"profile=0..{len(self.profiles) - 1}")
+        if not isinstance(profile, jax.core.Tracer):
+            value = int(profile)
+            if not 0 <= value < len(self.profiles):
+                raise ValueError(f"profile {value} is out of range; valid: 0..{len(self.profiles) - 1}")
+        return jnp.asarray(profile, jnp.int32)
 
     @property
     def skipping(self) -> bool:
@@ -124,7 +160,7 @@ class Machine:
 
     def _runner(self, frames: int, record_screens: bool):
         return frame.frame_runner(self.platform, self.quirks, self.instructions_per_frame, frames, record_screens,
-                                  self.skipping)
+                                  self.skipping, profiles=self.profiles)
 
 
 def _check_traced_frames(frames: jax.Array) -> None:

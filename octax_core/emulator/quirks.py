@@ -3,12 +3,21 @@
 Field names follow the Timendus quirks test ROM (`5-quirks`), so that its screen reports each
 field by name. Quirks change the traced program, so they live in the frozen `Machine` config,
 never in the state.
+
+A machine that runs several games at once (a mix, `Machine(profiles=...)`) gives each machine of
+the batch its own profile. Its quirks are then a `Quirks` whose fields are the profiles' common
+answer (a Python bool, as for one profile) where they agree, and the machine's own answer (a bool
+array, looked up from its profile index) where they differ; `choose` is how a handler reads a
+field either way, so a fixed profile traces exactly the program it always did.
 """
 
 from __future__ import annotations
 
 import dataclasses
-from typing import Union
+from typing import Sequence, Union
+
+import jax.numpy as jnp
+import numpy as np
 
 
 @dataclasses.dataclass(frozen=True)
@@ -30,6 +39,31 @@ class Quirks:
     clipping: bool
     shift_uses_vy: bool
     jump_uses_vx: bool
+
+
+FIELDS = tuple(field.name for field in dataclasses.fields(Quirks))
+
+
+def choose(flag, if_true, if_false):
+    """A quirk's two behaviours: picked while tracing for a fixed answer (a Python bool), per
+    machine for an answer that is data (a bool array, in a mix of profiles)."""
+    if isinstance(flag, (bool, np.bool_)):
+        return if_true if flag else if_false
+    return jnp.where(flag, if_true, if_false)
+
+
+def common(profiles: Sequence[Quirks]) -> dict[str, bool]:
+    """The fields on which every profile agrees, with their answer."""
+    return {name: getattr(profiles[0], name) for name in FIELDS
+            if len({getattr(profile, name) for profile in profiles}) == 1}
+
+
+def lane_quirks(profiles: Sequence[Quirks], index) -> Quirks:
+    """The quirks of the machine running profile `index` (an int32 scalar, traced): the common
+    answers as Python bools, the others as bool scalars looked up in a table of the profiles."""
+    shared = common(profiles)
+    return Quirks(**{name: shared[name] if name in shared
+                     else jnp.asarray([getattr(profile, name) for profile in profiles])[index] for name in FIELDS})
 
 
 QUIRK_PROFILES: dict[str, Quirks] = {

@@ -21,7 +21,7 @@ from __future__ import annotations
 
 import dataclasses
 import functools
-from typing import Any, Union
+from typing import Any, Optional, Union
 
 import jax
 import jax.numpy as jnp
@@ -45,6 +45,7 @@ class EnvState:
     episode_step: jax.Array  # () int32
     last_action: jax.Array  # () int32, repeated by sticky actions
     done: jax.Array  # () bool, the episode has ended; further steps change nothing
+    game: Optional[jax.Array] = None  # () int32, which game of a mix this env plays (`MixEnv`); else None
 
     def replace(self, **changes) -> "EnvState":
         return dataclasses.replace(self, **changes)
@@ -100,9 +101,12 @@ class Env:
 
         The observation repeats the start screen in every frame.
         """
-        machine = starts.draw(self._starts, key)
-        state = EnvState(machine=machine, score=self._score(machine), episode_step=jnp.int32(0),
-                         last_action=jnp.zeros(self._action_shape, jnp.int32), done=jnp.bool_(False))
+        return self._begin(starts.draw(self._starts, key), None)
+
+    def _begin(self, machine: MachineState, game) -> tuple[jax.Array, EnvState]:
+        """The first observation and state of an episode that starts from `machine`."""
+        state = EnvState(machine=machine, score=self._score(machine, game), episode_step=jnp.int32(0),
+                         last_action=jnp.zeros(self._action_shape, jnp.int32), done=jnp.bool_(False), game=game)
         screens = jnp.broadcast_to(shown(machine)[None], (self.config.frames_per_step, *shown(machine).shape))
         return self._observe(screens), state
 
@@ -117,25 +121,26 @@ class Env:
 
     def _transition(self, key: jax.Array, state: EnvState, action: jax.Array, params: EnvParams):
         """`step_env` after the action is checked: one env (`action` ()) or one per seat (`MultiEnv`)."""
+        game = state.game  # None but in a mix, where each hook reads its game's own
         repeat = jax.random.uniform(key, jnp.shape(action)) < params.repeat_action_probability
         action = jnp.where(repeat, state.last_action, action)
         # pgx's rule: an ended episode stands still until it is reset. The machine is halted
         # rather than stepped and then discarded, so its 4 KB of memory is never selected over,
         # and the frames it returns are its last screen.
-        machine, screens = _play(self.machine, self.config.frames_per_step, self.config.freeze_timers,
-                                 state.machine, self._keys_held(action), halted=state.done)
-        score = self._score(machine)
-        terminated = jnp.asarray(self.spec.terminated_fn(machine), jnp.bool_)
+        machine, screens = self._play(state.machine, self._keys_held(action, game), state.done, game)
+        score = self._score(machine, game)
+        terminated = jnp.asarray(self._terminated(machine, game), jnp.bool_)
         if machine.extension is not None:  # 00FD: the program has ended, so has the episode
             terminated = terminated | machine.extension.exited
         episode_step = jnp.where(state.done, state.episode_step, state.episode_step + 1)
-        truncated = ~terminated & (episode_step >= params.max_episode_steps)
+        truncated = ~terminated & (episode_step >= self._max_episode_steps(params, game))
         reward = jnp.where(state.done, 0.0, score - state.score).astype(jnp.float32)
-        if self.spec.survival_reward:  # a game with no score of its own: a reward per step survived
-            reward = reward + jnp.where(state.done | terminated, 0.0, self.spec.survival_reward).astype(jnp.float32)
+        survival = self._survival_reward(game)
+        if survival is not None:  # a game with no score of its own: a reward per step survived
+            reward = reward + jnp.where(state.done | terminated, 0.0, survival).astype(jnp.float32)
         new_state = EnvState(machine=machine, score=score, episode_step=episode_step,
                              last_action=jnp.where(state.done, state.last_action, action),
-                             done=terminated | truncated)
+                             done=terminated | truncated, game=game)
         return self._observe(screens), new_state, reward, terminated, truncated, self.info(new_state)
 
     # --- what a training loop adds ------------------------------------------------------------
@@ -169,25 +174,41 @@ class Env:
 
     def info(self, state: EnvState) -> dict[str, jax.Array]:
         """The per-step info of one env: score, lives (-1 where the game keeps none), episode_step."""
-        return {"score": state.score, "lives": self._lives(state.machine), "episode_step": state.episode_step}
+        return {"score": state.score, "lives": self._lives(state.machine, state.game),
+                "episode_step": state.episode_step}
 
-    # --- pieces (`MultiEnv` replaces those that differ for two seats) ---------------------------
+    # --- pieces (`MultiEnv` replaces those that differ for two seats, `MixEnv` those that differ
+    # per game; `game` is the env's game in a mix, None otherwise) ------------------------------
 
     _action_shape: tuple[int, ...] = ()  # one action a step
 
-    def _keys_held(self, action: jax.Array) -> jax.Array:
+    def _keys_held(self, action: jax.Array, game) -> jax.Array:
         """The keypad mask the action holds."""
         return jnp.asarray(self._action_masks)[action]
+
+    def _play(self, machine: MachineState, keys, halted, game):
+        """The machine's part of a step: the frames, recorded (`_play` below)."""
+        return _play(self.machine, self.config.frames_per_step, self.config.freeze_timers, machine, keys, halted)
+
+    def _terminated(self, machine: MachineState, game) -> jax.Array:
+        return self.spec.terminated_fn(machine)
+
+    def _max_episode_steps(self, params: EnvParams, game) -> jax.Array:
+        return params.max_episode_steps
+
+    def _survival_reward(self, game):
+        """The reward per step survived, or None for a game that keeps a score (nothing traced)."""
+        return self.spec.survival_reward or None
 
     def _observe(self, screens) -> jax.Array:
         if not self.machine.platform.extended:
             return unpack_screen(screens, on=self.config.obs_scale, dtype=jnp.uint8)
         return screen_values(screens, self.machine.platform, on=self.config.obs_scale)
 
-    def _score(self, machine: MachineState) -> jax.Array:
+    def _score(self, machine: MachineState, game) -> jax.Array:
         return jnp.asarray(self.spec.score_fn(machine), jnp.float32)
 
-    def _lives(self, machine: MachineState) -> jax.Array:
+    def _lives(self, machine: MachineState, game) -> jax.Array:
         if self.spec.lives_fn is None:
             return jnp.int32(-1)
         return jnp.asarray(self.spec.lives_fn(machine), jnp.int32)
@@ -206,9 +227,12 @@ class Env:
         return jnp.where((action >= 0) & (action < self.num_actions), action, 0)
 
 
-def _play(machine: Machine, frames_per_step: int, freeze_timers: bool, state: MachineState, keys, halted=None):
-    """The machine's part of an env step: the frames, recorded, then the timers frozen if asked."""
-    state, screens = machine.run_frames(state, keys, frames_per_step, halted=halted, record_screens=True)
+def _play(machine: Machine, frames_per_step: int, freeze_timers: bool, state: MachineState, keys, halted=None,
+          profile=None):
+    """The machine's part of an env step: the frames, recorded, then the timers frozen if asked
+    (`profile`: the game's, on a mix's machine)."""
+    state, screens = machine.run_frames(state, keys, frames_per_step, halted=halted, record_screens=True,
+                                        profile=profile)
     if freeze_timers:
         state = state.replace(delay_timer=jnp.zeros_like(state.delay_timer),
                               sound_timer=jnp.zeros_like(state.sound_timer))

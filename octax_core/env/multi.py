@@ -114,7 +114,7 @@ class MultiEnv(Env):
     def _action_shape(self) -> tuple[int, ...]:
         return (self.players,)
 
-    def _keys_held(self, actions: jax.Array) -> jax.Array:
+    def _keys_held(self, actions: jax.Array, game) -> jax.Array:
         """Either seat's key is held: the OR of the seats' masks."""
         held = jnp.asarray(self._seat_masks)[jnp.arange(self.players), actions]
         return jax.lax.reduce(held, np.uint32(0), jax.lax.bitwise_or, (0,))
@@ -125,7 +125,7 @@ class MultiEnv(Env):
         planes = jnp.broadcast_to(plane[:, None, None, None], (self.players, 1, *frames.shape[1:]))
         return jnp.concatenate([jnp.broadcast_to(frames[None], (self.players, *frames.shape)), planes], axis=1)
 
-    def _score(self, machine: MachineState) -> jax.Array:
+    def _score(self, machine: MachineState, game) -> jax.Array:
         scores = jnp.asarray(self.seats.score_fn(machine), jnp.float32)
         if scores.shape != (self.players,):
             raise ValueError(f"{self.spec.id}: Seats.score_fn must give ({self.players},) scores, got {scores.shape}")

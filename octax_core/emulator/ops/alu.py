@@ -5,6 +5,7 @@ from __future__ import annotations
 import jax.numpy as jnp
 
 from octax_core.emulator.ops import Context, Effect
+from octax_core.emulator.quirks import choose
 
 
 def op_6xnn(c: Context) -> Effect:
@@ -24,7 +25,11 @@ def op_8xy0(c: Context) -> Effect:
 
 def _logic(c: Context, value) -> Effect:
     # COSMAC VIP's logic ops ran through a routine that clobbered VF.
-    return Effect(vx=value, vf=jnp.int32(0)) if c.quirks.vf_reset else Effect(vx=value)
+    if isinstance(c.quirks.vf_reset, bool):
+        return Effect(vx=value, vf=jnp.int32(0)) if c.quirks.vf_reset else Effect(vx=value)
+    # A mix of profiles: VF is written either way, with what it holds after Vx is written.
+    unchanged = jnp.where(c.x == 0xF, value, c.V[0xF])
+    return Effect(vx=value, vf=jnp.where(c.quirks.vf_reset, 0, unchanged).astype(jnp.int32))
 
 
 def op_8xy1(c: Context) -> Effect:
@@ -59,7 +64,7 @@ def op_8xy7(c: Context) -> Effect:
 
 
 def _shift_source(c: Context):
-    return c.vy if c.quirks.shift_uses_vy else c.vx
+    return choose(c.quirks.shift_uses_vy, c.vy, c.vx)
 
 
 def op_8xy6(c: Context) -> Effect:

@@ -20,6 +20,7 @@ import jax.numpy as jnp
 import numpy as np
 
 from octax_core.emulator.ops import Context, Effect
+from octax_core.emulator.quirks import choose
 
 LORES = (32, 2)  # rows, words: the 64x32 surface
 HIRES = (64, 4)  # the 128x64 grid
@@ -63,8 +64,9 @@ def place(rows, x0, words: int, clipping: bool):
     k32 = jnp.arange(words, dtype=jnp.int32) * 32
     rows = rows[..., None]
     out = _shr(rows, x0 - k32) | _shl(rows, k32 - x0)
-    if not clipping:
-        out = out | _shl(rows, k32 + 32 * words - x0)
+    if clipping is not True:
+        wrapped = _shl(rows, k32 + 32 * words - x0)
+        out = out | (wrapped if clipping is False else jnp.where(clipping, jnp.uint32(0), wrapped))
     return out
 
 
@@ -77,10 +79,7 @@ def sprite_mask(patterns, x0, y0, height, surface: tuple[int, int], clipping: bo
     """
     rows, words = surface
     offset = jnp.arange(rows, dtype=jnp.int32) - y0
-    if clipping:
-        covered = (offset >= 0) & (offset < height)
-    else:
-        covered = (offset & (rows - 1)) < height
+    covered = choose(clipping, (offset >= 0) & (offset < height), (offset & (rows - 1)) < height)
     # Row r shows pattern (r - y0) mod 16: a window of the patterns repeated, one slice per
     # machine (a contiguous gather under vmap, which XLA keeps as its own small buffer, so the
     # shifts that follow are all the collision test and the XOR recompute).

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from octax_core.emulator.ops import Context, Effect, next_pc
+from octax_core.emulator.quirks import choose
 
 
 def op_00ee(c: Context) -> Effect:
@@ -42,7 +43,7 @@ def op_9xy0(c: Context) -> Effect:
 
 def op_bnnn(c: Context) -> Effect:
     """JP V0, nnn (or JP Vx, xnn with jump_uses_vx)."""
-    return Effect(pc=c.nnn + (c.vx if c.quirks.jump_uses_vx else c.v0))
+    return Effect(pc=c.nnn + choose(c.quirks.jump_uses_vx, c.vx, c.v0))
 
 
 def op_stall(c: Context) -> Effect:

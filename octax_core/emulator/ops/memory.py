@@ -31,7 +31,9 @@ def op_fx33(c: Context) -> Effect:
 
 def _i_after_transfer(c: Context):
     """I after FX55/FX65: advanced by X + 1 with memory_increment, else untouched (None)."""
-    return c.I + c.x + 1 if c.quirks.memory_increment else None
+    if isinstance(c.quirks.memory_increment, bool):
+        return c.I + c.x + 1 if c.quirks.memory_increment else None
+    return jnp.where(c.quirks.memory_increment, c.I + c.x + 1, c.I)  # a mix of profiles
 
 
 def op_fx55(c: Context) -> Effect:

@@ -1,0 +1,160 @@
+"""Many games in one batch (`octax_core.make_mix`): each env of a mix plays, step for step, what
+`make(game)` plays from the same keys and actions; and the mix's own API and errors."""
+
+from __future__ import annotations
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+import pytest
+
+import octax_core
+
+from counter_game import COUNTER
+
+# CHIP-8 games with different quirks (Blinky: schip), speeds (7 to 100 instructions a frame; 30
+# and 100 skip idle instructions), keys (1 to 6), survival rewards (GhostEscape) and frozen timers
+MIXED = ["Pong", "Blinky", "Br8kout", "Carbon8", "SlipperySlope", "GhostEscape", "SpacejamArchive", "Dodge"]
+OPTIONS = dict(noop_max=3, repeat_action_probability=0.25)
+STEPS = 40
+
+
+def _rollout(env, params, key, num_actions, game=None):
+    """An episode's first STEPS steps: random actions in 0..num_actions-1 drawn from `key`."""
+    obs, state = env.reset(key, params) if game is None else env.reset(key, params, game=game)
+
+    def one(carry, _):
+        state, key = carry
+        key, action_key, step_key = jax.random.split(key, 3)
+        action = jax.random.randint(action_key, (), 0, num_actions)
+        obs, state, reward, terminated, truncated, info = env.step(step_key, state, action, params)
+        return (state, key), (obs, reward, terminated, truncated, info["score"], info["lives"], info["episode_step"])
+
+    return obs, jax.lax.scan(one, (state, key), None, length=STEPS)[1]
+
+
+@pytest.fixture(scope="module")
+def mix():
+    env, params = octax_core.make_mix(MIXED, **OPTIONS)
+    # one compile for every game: the game and its action count are arguments
+    rollouts = jax.jit(jax.vmap(lambda k, n, g: _rollout(env, params, k, n, g), in_axes=(0, None, None)))
+    return env, params, rollouts
+
+
+@pytest.mark.parametrize("index", range(len(MIXED)))
+def test_an_env_of_the_mix_plays_what_make_plays(mix, index):
+    env, params, rollouts = mix
+    single, single_params = octax_core.make(MIXED[index], **OPTIONS)
+    keys = jax.random.split(jax.random.key(index), 3)
+    expected = jax.jit(jax.vmap(lambda k: _rollout(single, single_params, k, single.num_actions)))(keys)
+    got = rollouts(keys, single.num_actions, index)
+    for want, have in zip(jax.tree.leaves(expected), jax.tree.leaves(got)):
+        np.testing.assert_array_equal(want, have)
+
+
+def test_one_batch_plays_every_game_at_once(mix):
+    env, params, _ = mix
+    games = jnp.arange(len(MIXED))
+    keys = jax.random.split(jax.random.key(9), len(MIXED))
+    step = jax.jit(jax.vmap(env.step, in_axes=(0, 0, 0, None)))
+    obs, state = jax.vmap(lambda k, g: env.reset(k, params, game=g))(keys, games)
+    singles = [octax_core.make(game, **OPTIONS) for game in MIXED]
+    single_states = [single.reset(keys[i], p)[1] for i, (single, p) in enumerate(singles)]
+    for t in range(5):
+        actions = jnp.array([t % single.num_actions for single, _ in singles])
+        step_keys = jax.random.split(jax.random.key(100 + t), len(MIXED))
+        obs, state, reward, terminated, truncated, info = step(step_keys, state, actions, params)
+        np.testing.assert_array_equal(info["game"], games)
+        for i, (single, p) in enumerate(singles):
+            single_obs, single_states[i], single_reward, *_ = single.step(step_keys[i], single_states[i],
+                                                                          actions[i], p)
+            np.testing.assert_array_equal(obs[i], single_obs)
+            assert float(reward[i]) == float(single_reward)
+
+
+def test_reset_draws_games_by_weight_and_reports_them():
+    env, params = octax_core.make_mix(["Pong", "Brix", "Tetris"], weights=[1, 0, 3])
+    keys = jax.random.split(jax.random.key(0), 400)
+    _, state = jax.vmap(env.reset, in_axes=(0, None))(keys, params)
+    counts = np.bincount(np.asarray(state.game), minlength=3)
+    assert counts[1] == 0 and 60 < counts[0] < 140 and counts[0] + counts[2] == 400
+    assert env.games == ("Pong", "Brix", "Tetris") and env.num_games == 3
+    info = env.info(jax.tree.map(lambda leaf: leaf[0], state))
+    assert set(info) >= {"game", "action_mask", "score", "lives", "episode_step"}
+
+
+def test_the_action_space_is_the_largest_games_with_a_mask_per_game():
+    env, params = octax_core.make_mix(["Pong", "Tetris", "Missile"])  # 2, 4 and 1 keys
+    assert env.num_actions == 5
+    masks = [np.asarray(env.info(env.reset(jax.random.key(0), params, game=g)[1])["action_mask"]) for g in range(3)]
+    np.testing.assert_array_equal(masks, [[1, 1, 1, 0, 0], [1, 1, 1, 1, 1], [1, 1, 0, 0, 0]])
+    # an action past the game's last holds no key: it plays as no-op
+    _, state = env.reset(jax.random.key(0), params, game=2)
+    past = env.step(jax.random.key(1), state, 4, params)
+    noop = env.step(jax.random.key(1), state, 0, params)
+    assert int(past[1].last_action) == 4  # what was asked, kept for sticky actions
+    past = (past[0], past[1].replace(last_action=noop[1].last_action), *past[2:])
+    for a, b in zip(jax.tree.leaves(past), jax.tree.leaves(noop)):
+        np.testing.assert_array_equal(a, b)
+
+
+def test_autoreset_starts_the_next_episode_on_a_drawn_game():
+    env, params = octax_core.make_mix(["Pong", "Brix"], weights=[0, 1], autoreset=True, max_episode_steps=2)
+    obs, state = env.reset(jax.random.key(0), params, game=0)
+    step = jax.jit(env.step)
+    for t in range(2):
+        obs, state, reward, terminated, truncated, info = step(jax.random.key(t), state, 0, params)
+    assert bool(truncated) and int(info["game"]) == 0 and int(state.game) == 1  # the new episode: Brix
+
+
+def test_per_game_episode_lengths_are_params(mix):
+    env, params, _ = mix
+    lengths = [octax_core.get_spec(game).max_episode_steps for game in MIXED]
+    np.testing.assert_array_equal(params.max_episode_steps, lengths)
+    _, short = octax_core.make_mix(["Pong", "Brix"], max_episode_steps=7)
+    np.testing.assert_array_equal(short.max_episode_steps, [7, 7])
+
+
+def test_bad_mixes_are_named_errors():
+    with pytest.raises(ValueError, match="non-empty list of games; valid ids: .*Pong"):
+        octax_core.make_mix([])
+    with pytest.raises(ValueError, match="non-empty list of games"):
+        octax_core.make_mix("Pong")
+    with pytest.raises(KeyError, match="unknown game 'Nope'"):
+        octax_core.make_mix(["Pong", "Nope"])
+    with pytest.raises(ValueError, match=r"one platform, got several \(chip8: Pong; schip: Rockto\)"):
+        octax_core.make_mix(["Pong", "Rockto"])
+    with pytest.raises(ValueError, match=r"weights must be one number per game \(2\)"):
+        octax_core.make_mix(["Pong", "Brix"], weights=[1, 2, 3])
+    with pytest.raises(ValueError, match="weights must be finite, >= 0 and not all 0"):
+        octax_core.make_mix(["Pong", "Brix"], weights=[0, 0])
+    with pytest.raises(TypeError, match="unknown keyword"):
+        octax_core.make_mix(["Pong"], speed=3)
+    env, params = octax_core.make_mix(["Pong", "Brix"])
+    with pytest.raises(ValueError, match="game 2 is out of range; this mix's games are 0..1: 0 Pong, 1 Brix"):
+        env.reset(jax.random.key(0), params, game=2)
+    _, state = env.reset(jax.random.key(0), params, game=0)
+    with pytest.raises(ValueError, match=r"action 3 is out of range; valid actions are 0..2"):
+        env.step(jax.random.key(0), state, 3, params)
+
+
+def test_a_users_game_spec_mixes_with_registered_ones(counter_rom):
+    env, params = octax_core.make_mix([COUNTER, "Pong"], roms=[counter_rom, None])
+    _, state = env.reset(jax.random.key(0), params, game=0)
+    _, state, reward, *_ = env.step(jax.random.key(0), state, 1, params)
+    single, single_params = octax_core.make(COUNTER, rom=counter_rom)
+    _, single_state = single.reset(jax.random.key(0), single_params)
+    _, _, single_reward, *_ = single.step(jax.random.key(0), single_state, 1, single_params)
+    assert float(reward) == float(single_reward) == 4.0
+
+
+def test_a_machine_of_profiles_needs_its_profile():
+    machine = octax_core.Machine("chip8", profiles=(("chip8", 11), ("schip", 15)))
+    assert machine.instructions_per_frame == 15 and machine.quirks == octax_core.QUIRK_PROFILES["chip8"]
+    state = machine.boot(bytes([0x12, 0x00]), jax.random.key(0))
+    with pytest.raises(ValueError, match="runs 2 profiles: give run_frames/execute profile=0..1"):
+        machine.run_frames(state, 0, 1)
+    with pytest.raises(ValueError, match="profile 2 is out of range; valid: 0..1"):
+        machine.run_frames(state, 0, 1, profile=2)
+    with pytest.raises(ValueError, match="profile= is for a Machine with profiles"):
+        octax_core.Machine("chip8").run_frames(state, 0, 1, profile=0)
