@@ -15,6 +15,9 @@ imported only when asked for. See docs/gymnasium.md.
 Two-player games: `MultiAgentVectorEnv` / `make_multi_vec` (both seats, batched),
 `octax_gym.pettingzoo` (`parallel_env`, `env`), and any two-player id with `opponent=` for one seat
 against a fixed opponent (`octax_gym.opponent`). See docs/pettingzoo.md.
+
+Many games in one batch: `gym.make_vec("octax/Mix-v0", num_envs=N, games=[...])` (`MIX_ENV_ID`,
+`octax_core.make_mix`). See docs/mix.md.
 """
 
 from octax_gym.action_check import IllegalMoveError, InvalidActionError
@@ -23,12 +26,13 @@ from octax_gym.env import OctaxEnv
 from octax_gym.game_names import NAMESPACE, env_id
 from octax_gym.multi_vector import MultiAgentVectorEnv, make_multi_vec
 from octax_gym.opponent import OpponentRequiredError
-from octax_gym.registration import register_all, register_game, register_two_player
+from octax_gym.registration import MIX_ENV_ID, register_all, register_game, register_mix, register_two_player
 from octax_gym.render import PALETTES
 from octax_gym.vector import OctaxVectorEnv
 
 ENV_IDS = tuple(register_all())  # the one-player envs (`octax_core.list_games()`)
 TWO_PLAYER_ENV_IDS = tuple(register_two_player())  # `list_games(players=2)`: with opponent=, or MultiAgentVectorEnv
+register_mix()  # octax/Mix-v0: many games in one batch (games=[...])
 
 # The adapters import torch, SB3 or TorchRL, the dataset collector Minari: loaded on first use
 # (`octax_gym.make_sb3_vec_env`), never by `import octax_gym`.
@@ -44,6 +48,6 @@ def __getattr__(name: str):
     raise AttributeError(f"module 'octax_gym' has no attribute {name!r}")
 
 
-__all__ = ["ENV_IDS", "IllegalMoveError", "InvalidActionError", "MultiAgentVectorEnv", "NAMESPACE", "OctaxEnv",
+__all__ = ["ENV_IDS", "IllegalMoveError", "MIX_ENV_ID", "InvalidActionError", "MultiAgentVectorEnv", "NAMESPACE", "OctaxEnv",
            "OctaxVectorEnv", "OpponentRequiredError", "PALETTES", "TWO_PLAYER_ENV_IDS", "UnknownOptionError", "env_id",
-           "make_multi_vec", "register_all", "register_game", "register_two_player", *_LAZY]
+           "make_multi_vec", "register_all", "register_game", "register_mix", "register_two_player", *_LAZY]

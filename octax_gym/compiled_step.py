@@ -22,8 +22,11 @@ a fixed opponent: the learner's actions (N,) go in, the opponent's are made insi
 come from the host), and the learner's observation, reward and info come out, so that
 `OctaxVectorEnv(game, opponent=...)` is a one-player env to every caller.
 
-`CompiledStep`s are cached per (game, config, ROM, players, view), so every env of one game shares
-its compilations.
+A mix of games (`octax_core.make_mix`, `build_mix`) runs through it too: its env is a `MixEnv`,
+whose actions past an env's game's last are no-op and whose info adds `game` and `action_mask`.
+
+`CompiledStep`s are cached per (game, config, ROM, players, view), or per (games, weights,
+options) for a mix, so every env of one game or mix shares its compilations.
 """
 
 from __future__ import annotations
@@ -39,6 +42,7 @@ from gymnasium.vector import AutoresetMode
 import octax_core
 from octax_core.env import ENV_OPTIONS, Env, EnvConfig, EnvParams, EnvState, GameSpec
 from octax_core.env.games import list_games
+from octax_core.env.mix import MIXES, MixEnv
 from octax_core.env.multi import MultiEnv
 from octax_gym import action_check, opponent
 from octax_gym.game_names import resolve_spec
@@ -157,6 +161,31 @@ def _compiled_step(spec: GameSpec, config: EnvConfig, rom: Optional[str], player
     if players == 1:
         return CompiledStep(Env(spec, config, rom))
     return CompiledStep(MultiEnv(spec, config, rom), view)
+
+
+@functools.lru_cache(maxsize=16)
+def _compiled_mix(specs: tuple[GameSpec, ...], weights: Optional[tuple[float, ...]],
+                  options: tuple[tuple[str, Any], ...]) -> CompiledStep:
+    return CompiledStep(MixEnv(specs, weights, dict(options)))
+
+
+def is_mix(game: Any) -> bool:
+    """Whether `game` names several games: a list or tuple of games, or a mix in `MIXES`."""
+    return isinstance(game, (list, tuple)) or (isinstance(game, str) and game in MIXES)
+
+
+def build_mix(games: Any, weights, options: dict[str, Any]) -> tuple[CompiledStep, EnvParams]:
+    """The cached compiled step of a mix (`octax_core.make_mix`): a list of games (any names
+    `resolve_spec` takes, or `GameSpec`s) or a mix's name, `weights` per game (None: uniform)."""
+    names = MIXES[games] if isinstance(games, str) else games
+    if not len(names):
+        raise ValueError(f"a mix needs a non-empty list of games, or one of the named mixes: {', '.join(MIXES)}")
+    specs = tuple(resolve_spec(game) for game in names)
+    given = tuple(sorted((name, value) for name, value in options.items() if value is not None))
+    octax_core.make_config(specs[0], autoreset=False, **options)  # checks every option first
+    weights = None if weights is None else tuple(float(w) for w in weights)
+    compiled = _compiled_mix(specs, weights, given + (("autoreset", False),))
+    return compiled, compiled.env.default_params
 
 
 def build(game: Any, rom, options: dict[str, Any], *, players: int = 1,

@@ -34,6 +34,23 @@ def register_two_player() -> list[str]:
     return [env_id(game) if game in solo else _register(game) for game in list_games(players=2)]
 
 
+MIX_ENV_ID = f"{NAMESPACE}/Mix-v0"
+
+
+def register_mix() -> str:
+    """Registers `octax/Mix-v0`: many games in one batch (`octax_core.make_mix`), given as
+    `games=[...]` (or a named mix, "octax16", the default) and `weights=`."""
+    gymnasium.register(
+        id=MIX_ENV_ID,
+        entry_point="octax_gym.env:OctaxEnv",
+        vector_entry_point="octax_gym.vector:OctaxVectorEnv",
+        kwargs={"game": "octax16"},
+        max_episode_steps=None,
+        disable_env_checker=False,
+    )
+    return MIX_ENV_ID
+
+
 def _register(game: str) -> str:
     gym_id = env_id(game)
     gymnasium.register(

@@ -96,6 +96,13 @@ class OctaxVectorEnv(gymnasium.vector.VectorEnv):
             default): a one-player env; a game that is not one (`GameSpec.solo` False) then
             raises `OpponentRequiredError`.
         seat: the learner's seat against `opponent`: 0 (the default, first_0) or 1 (second_0).
+        games: a mix of games in one batch (`octax_core.make_mix`): a list of game names (one
+            platform), or a named mix ("octax16"), in place of `game` ("octax/Mix-v0" takes it).
+            Each env plays one of them, drawn from `weights` at every reset; the action space is
+            the largest game's (an action past an env's game's last holds no key), and `info`
+            adds `game` (the index into `games`) and `action_mask` (the actions its game takes).
+            `game` may also be given as such a list or name.
+        weights: how often each game of the mix is drawn (normalised); None: uniform.
         **env_options: the core env's options (`octax_core.env.config`; None or absent = the
             game's default), all but `autoreset`: frames_per_step, instructions_per_frame,
             obs_scale, freeze_timers and noop_max, fixed at construction (`EnvConfig`), and
@@ -109,8 +116,14 @@ class OctaxVectorEnv(gymnasium.vector.VectorEnv):
                  autoreset_mode: Union[AutoresetMode, str] = AutoresetMode.NEXT_STEP,
                  backend: str = "numpy", device: Any = None, render_mode: Optional[str] = None,
                  render_scale: int = render.DEFAULT_RENDER_SCALE, palette: Optional[render.PaletteArg] = None,
-                 rom=None, opponent: Any = None, seat: int = 0, **env_options):
+                 rom=None, opponent: Any = None, seat: int = 0, games: Any = None, weights: Any = None,
+                 **env_options):
         check_option_names(env_options, KEYWORDS, type(self).__name__)
+        if games is not None:  # "octax/Mix-v0" with games=[...]
+            game = games if isinstance(games, str) else tuple(games)
+        if weights is not None and not compiled_step.is_mix(game):
+            raise ValueError("weights= is for a mix of games (games=[...]); one game has no weights")
+        self._weights = weights
         self._setup(game, num_envs, autoreset_mode, backend, device, render_mode, render_scale, palette, rom,
                     env_options, opponent=opponent, seat=seat)
 
@@ -126,21 +139,28 @@ class OctaxVectorEnv(gymnasium.vector.VectorEnv):
         if palette is not None:
             self.palette = render.resolve_palette(palette)  # a bad one raises before the build
         view = self._opponent = None
-        if players == 1:
+        mix = players == 1 and compiled_step.is_mix(game)
+        if mix:
+            if opponent is not None or rom is not None:
+                raise ValueError("a mix of games takes no opponent= or rom= (each game's ROM comes from the store)")
+            self._compiled, params = compiled_step.build_mix(game, getattr(self, "_weights", None), env_options)
+        elif players == 1:
             spec = resolve_spec(game)
             view, self._opponent = opponents.resolve(opponent, seat, spec)
             if view is not None:
                 players, game = 2, spec
         self.view = view
-        self._compiled, params = build(game, rom, env_options, players=players, view=view)
+        if not mix:
+            self._compiled, params = build(game, rom, env_options, players=players, view=view)
         self.core_env = self._compiled.env
-        self.game_spec = self.core_env.spec
+        self.game_spec = self.core_env.spec  # a mix's first game's (its palette is the mix's)
+        self.game_name = f"mix({', '.join(self.core_env.games)})" if mix else self.game_spec.id
         self.agents = getattr(self.core_env, "agents", None)  # the seats' names in a two-player env
         if palette is None:
             self.palette = render.resolve_palette(self.game_spec.palette or render.DEFAULT_PALETTE)
         self.params = jax.device_put(params, self.device)
         self._step_fn = self._compiled.step[self.autoreset_mode]
-        self._action_check = action_check.DeferredCheck(self.game_spec.id, self.core_env.num_actions, self.device,
+        self._action_check = action_check.DeferredCheck(self.game_name, self.core_env.num_actions, self.device,
                                                         self.agents)
 
         config = self.core_env.config
@@ -226,7 +246,7 @@ class OctaxVectorEnv(gymnasium.vector.VectorEnv):
         """The step's actions checked (`octax_gym.action_check`) and on the device; against an
         opponent, host actions are checked against the learner's `action_mask` too."""
         actions, unchecked = action_check.to_device(actions, self.num_envs, self.single_action_space.n,
-                                                    self.device, self.game_spec.id)
+                                                    self.device, self.game_name)
         if self.view is not None and self.core_env.turn_based and not unchecked:
             both = np.zeros((self.num_envs, 2), np.int32)
             both[:, self.view.seat] = np.asarray(actions)
@@ -256,7 +276,7 @@ class OctaxVectorEnv(gymnasium.vector.VectorEnv):
 
     @property
     def game(self) -> str:
-        return self.game_spec.id
+        return self.game_name
 
     @property
     def state(self):
@@ -275,7 +295,7 @@ class OctaxVectorEnv(gymnasium.vector.VectorEnv):
 
     def __repr__(self) -> str:
         against = "" if self.view is None else f", seat={self.view.seat}, opponent={self.view.opponent!r}"
-        return f"{type(self).__name__}({self.game_spec.id}, num_envs={self.num_envs}, backend={self.backend!r}{against})"
+        return f"{type(self).__name__}({self.game_name}, num_envs={self.num_envs}, backend={self.backend!r}{against})"
 
 
 # Every keyword the vector env takes: its own (the keyword-only arguments above) and the core's

@@ -21,7 +21,8 @@ the next episode on a game drawn from `weights` again.
 
 The action space is the largest game's: action `a` of an env is its game's own action `a`
 (0 = no-op), and an action past its game's last holds no key (`info["action_mask"]` marks the
-actions each env's game takes; the Gymnasium layer refuses the others). One platform per mix:
+actions each env's game takes, for a masked policy; an unmasked one, SB3's PPO say, just wastes
+those actions, as it would a no-op). One platform per mix:
 CHIP-8 games together, SUPER-CHIP games together, XO-CHIP games together (the machine's memory
 and screen are the platform's).
 """
@@ -60,6 +61,7 @@ class MixEnv(Env):
                  roms: Optional[Sequence] = None):
         from octax_core.env.romstore import load_game_rom  # the store does file I/O: only at make
 
+        _check_specs(specs, roms)
         self.specs = tuple(specs)
         self.spec = self.specs[0]
         self.weights = _check_weights(weights, len(self.specs))
@@ -176,6 +178,21 @@ class MixEnv(Env):
         return jnp.where((action >= 0) & (action < self.num_actions), action, 0)
 
 
+def _check_specs(specs: Sequence[GameSpec], roms) -> None:
+    """Raises ValueError for a mix that cannot be one program: no games, several platforms, a
+    two-player-only game, roms that do not match the games."""
+    if not len(specs):
+        raise ValueError(f"a mix needs a non-empty list of games or a named mix ({', '.join(MIXES)})")
+    platforms = sorted({spec.platform for spec in specs})
+    if len(platforms) > 1:
+        by_platform = "; ".join(f"{p}: " + ", ".join(s.id for s in specs if s.platform == p) for p in platforms)
+        raise ValueError(f"a mix runs games of one platform, got several ({by_platform})")
+    if not_solo := [spec.id for spec in specs if not spec.solo]:
+        raise ValueError(f"{', '.join(not_solo)}: played by two, not a one-player env; a mix takes one-player games")
+    if roms is not None and len(roms) != len(specs):
+        raise ValueError(f"roms must be one path (or None) per game ({len(specs)}), got {len(roms)}")
+
+
 def _check_weights(weights, count: int) -> np.ndarray:
     if weights is None:
         return np.full(count, 1.0 / count, np.float32)
@@ -210,13 +227,5 @@ def make_mix(games: Sequence[Union[str, GameSpec]], weights: Optional[Sequence[f
         raise ValueError(f"make_mix needs a non-empty list of games or a named mix ({', '.join(MIXES)}); "
                          f"valid ids: {', '.join(list_games())}")
     specs = [game if isinstance(game, GameSpec) else get_spec(game) for game in games]
-    platforms = sorted({spec.platform for spec in specs})
-    if len(platforms) > 1:
-        by_platform = "; ".join(f"{p}: " + ", ".join(s.id for s in specs if s.platform == p) for p in platforms)
-        raise ValueError(f"a mix runs games of one platform, got several ({by_platform})")
-    if not_solo := [spec.id for spec in specs if not spec.solo]:
-        raise ValueError(f"{', '.join(not_solo)}: played by two, not a one-player env; a mix takes one-player games")
-    if roms is not None and len(roms) != len(specs):
-        raise ValueError(f"roms must be one path (or None) per game ({len(specs)}), got {len(roms)}")
     env = MixEnv(specs, weights, options, roms)
     return env, env.default_params
