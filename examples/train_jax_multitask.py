@@ -11,9 +11,9 @@ the minibatch epochs, unchanged; examples/jax_training.py: the command line). Wh
 - The env is `octax_core.make_mix(games)`, one compiled program in which each of the `--num-envs`
   envs plays one game. The action space is the largest game's (`env.num_actions`); an action past
   an env's game's last is a no-op, so the policy's logits are masked with the game's action mask
-  (`MixEnv.action_mask`: an illegal action's logit is set to -1e9 inside the network, so acting,
-  the log-probs and the entropy of the loss and the evaluation all see the masked policy and an
-  illegal action is never sampled).
+  (`MixEnv.action_mask`; the `Masked` module sets an illegal action's logit to -1e9 after the
+  network, so acting, the loss's log-probs and entropy and the evaluation all see the masked
+  policy, and an illegal action is never sampled: each update counts them, `illegal_actions`).
 - Lanes are fixed per game: env i plays game i mod G for the whole run (its first reset and every
   autoreset are forced to that game), so every game gets exactly num_envs / G envs and
   total_steps / G env steps: the same data per game as a single-game agent given total_steps / G
@@ -57,7 +57,7 @@ import math
 import sys
 import time
 from pathlib import Path
-from typing import Any, Callable, Optional, Sequence
+from typing import Callable, Optional, Sequence
 
 import flax.linen as nn
 import flax.serialization
@@ -158,37 +158,54 @@ def lane_games(num_envs: int, num_games: int) -> jax.Array:
 
 class MultiTaskActorCritic(nn.Module):
     """The PPO example's network (`jax_networks.ActorCritic`: the paper's CNN torso, separate
-    256-unit actor and critic heads) for a mix: takes (frames, game) and masks the logits of the
-    actions the game does not take. With `game_input`, the game's one-hot joins the torso's features."""
+    256-unit actor and critic heads) on (frames, game) pairs: with `game_input`, the game's one-hot
+    joins the torso's 1,024 features before the heads; without, the game is not read."""
 
-    legal: tuple  # (num_games, num_actions) bools, nested tuples (a constant of the program; hashable)
+    num_actions: int
+    num_games: int
     game_input: bool = True
 
     @nn.compact
     def __call__(self, obs) -> tuple[jax.Array, jax.Array]:
         frames, game = obs
-        legal = jnp.asarray(np.array(self.legal, bool))
-        num_games, num_actions = legal.shape
         features = ConvTorso()(frames)
         if self.game_input:
-            features = jnp.concatenate([features, jax.nn.one_hot(game, num_games, dtype=features.dtype)], -1)
+            features = jnp.concatenate([features, jax.nn.one_hot(game, self.num_games, dtype=features.dtype)], -1)
         actor = nn.relu(nn.Dense(HIDDEN, kernel_init=orthogonal(math.sqrt(2)))(features))
-        logits = nn.Dense(num_actions, kernel_init=orthogonal(0.01))(actor)
+        logits = nn.Dense(self.num_actions, kernel_init=orthogonal(0.01))(actor)
         critic = nn.relu(nn.Dense(HIDDEN, kernel_init=orthogonal(math.sqrt(2)))(features))
         value = nn.Dense(1, kernel_init=orthogonal(1.0))(critic)
-        return jnp.where(legal[game], logits, NEG), value[:, 0]
+        return logits, value[:, 0]
+
+
+class Masked(nn.Module):
+    """`net` ((frames, game) -> (logits, values)) with each env's logits masked by its game's
+    legal actions: an action the game does not take gets logit -1e9, so its probability is 0
+    (exactly, in float32) when acting, in the loss's log-probs and entropy, and in evaluation."""
+
+    net: nn.Module
+    legal: tuple  # (num_games, num_actions) bools, nested tuples (a constant of the program; hashable)
+
+    def __call__(self, obs) -> tuple[jax.Array, jax.Array]:
+        logits, value = self.net(obs)
+        return masked_logits(logits, obs[1], self.legal), value
+
+
+def masked_logits(logits: jax.Array, game: jax.Array, legal) -> jax.Array:
+    """(B, A) logits with the actions game (B,) does not take set to -1e9 (`legal`: (G, A) bools)."""
+    return jnp.where(jnp.asarray(np.array(legal, bool))[game], logits, NEG)
 
 
 def legal_table(mix) -> tuple:
     """The mix's action masks, (num_games, num_actions) bools as nested tuples: row g marks the
-    actions game g takes (no-op and its keys), as `MixEnv.action_mask` reads them."""
-    return tuple(tuple(bool(x) for x in row) for row in np.asarray(mix._legal))
+    actions game g takes, no-op (0) and its keys (1 .. its number of keys), as `MixEnv.action_mask`."""
+    return tuple(tuple(a <= len(spec.action_keys) for a in range(mix.num_actions)) for spec in mix.specs)
 
 
 def random_policy(legal: np.ndarray) -> Callable:
     """Uniform over each env's game's legal actions: `(params, key, (frames, game)) -> actions`."""
-    table = jnp.asarray(np.array(legal, bool))
-    return lambda _, key, obs: jax.random.categorical(key, jnp.where(table[obs[1]], 0.0, NEG))
+    return lambda _, key, obs: jax.random.categorical(key, masked_logits(jnp.zeros((obs[1].shape[0], len(legal[0]))),
+                                                                         obs[1], legal))
 
 
 # --- training -----------------------------------------------------------------------------------
@@ -200,12 +217,16 @@ def make_envs(config: Config, games=None, roms=None):
     return mix, TaskEnv(mix, config.redraw_games), params
 
 
-def make_train(config: Config, env: TaskEnv, env_params) -> jax_training.Trainer:
-    """PPO on `env`: `ppo.make_train` with the multi-task network, fixed-lane resets and per-game
-    training stats; a `jax_training.Trainer` (jit `update` yourself)."""
+def make_train(config: Config, env: TaskEnv, env_params, network: Optional[nn.Module] = None
+               ) -> jax_training.Trainer:
+    """PPO on `env`: `ppo.make_train`'s update with the multi-task network, fixed-lane resets and
+    per-game training stats; a `jax_training.Trainer` (jit `update` yourself). `network`: a flax
+    module (frames, game) -> (logits (B, A), values (B,)), masked here; None: `MultiTaskActorCritic`."""
     config.check()
     num_games, n = len(env.games), config.num_envs
-    network = MultiTaskActorCritic(legal_table(env.mix), config.game_input)
+    if network is None:
+        network = MultiTaskActorCritic(env.num_actions, num_games, config.game_input)
+    network = Masked(network, legal_table(env.mix))
     optimizer = jax_update.make_optimizer(config)
 
     def init(key):
@@ -240,7 +261,7 @@ def make_train(config: Config, env: TaskEnv, env_params) -> jax_training.Trainer
                         "steps_by_game": by_game.sum((0, 1)),
                         "episodes_by_game": (by_game * traj.done[..., None]).sum((0, 1)),
                         "return_sum_by_game": (by_game * traj.finished_return[..., None]).sum((0, 1)),
-                        "illegal_actions": (~jnp.asarray(np.array(network.legal, bool))[traj.obs[1], traj.action]).sum()}
+                        "illegal_actions": (~jnp.asarray(np.array(network.legal))[traj.obs[1], traj.action]).sum()}
 
     return jax_training.Trainer("PPO", network, init, update, ppo.policy_act(network), lambda r: r.params,
                                 PPO_METRICS, lambda i: {})
@@ -304,18 +325,19 @@ def csv_columns(games: Sequence[str]) -> tuple[str, ...]:
              "train_episodes", "illegal_actions") + per_game + PPO_METRICS)
 
 
-def train(config: Config, out_dir, games=None, roms=None, progress: bool = True) -> dict:
+def train(config: Config, out_dir, games=None, roms=None, progress: bool = True,
+          network: Optional[nn.Module] = None) -> dict:
     """Trains the multi-task agent, evaluating every game as configured; writes config.json,
     progress.csv, learning_curve.png, final.csv and params.msgpack to `out_dir` and, with
     `config.single_baseline`, the single-game agents (`out_dir/single-<game>/`), comparison.csv and
     comparison.png. `games` (ids or `GameSpec`s) and `roms` default to `config.game_list` and the
-    ROM store. Returns a summary: paths, rows, per-game final returns and normalized scores, IQM."""
+    ROM store; `network` to `MultiTaskActorCritic` (see `make_train`). Returns a summary: paths, rows, per-game final returns and normalized scores, IQM."""
     config.check()
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
     mix, env, env_params = make_envs(config, games, roms)
     names = mix.games
-    trainer = make_train(config, env, env_params)
+    trainer = make_train(config, env, env_params, network)
     eval_steps = config.eval_max_steps or int(np.max(np.asarray(env_params.max_episode_steps)))
     evaluate_policy = make_evaluate(mix, env_params, config.eval_envs, eval_steps, trainer.act)
     evaluate_random = make_evaluate(mix, env_params, config.eval_envs, eval_steps, random_policy(legal_table(mix)))
