@@ -18,11 +18,15 @@ def help_of(parser: argparse.ArgumentParser) -> Callable[[argparse.Namespace], i
     return show
 
 
-def game_specs() -> list:
-    """Every registered `GameSpec` (imports the registry, hence JAX)."""
+def game_specs(two_player_only: bool = False) -> list:
+    """Every one-player `GameSpec` of the registry (imports it, hence JAX); with `two_player_only`
+    also the two-player games that are no one-player env (their ROMs are installed alike)."""
     from octax_core.env.games import get_spec, list_games
 
-    return [get_spec(game_id) for game_id in list_games()]
+    games = list_games()
+    if two_player_only:
+        games = sorted(set(games) | set(list_games(players=2)))
+    return [get_spec(game_id) for game_id in games]
 
 
 def print_table(rows: list[tuple[str, ...]]) -> None:

@@ -40,7 +40,7 @@ def add_commands(commands: argparse._SubParsersAction) -> None:
 def _cmd_roms_list(args: argparse.Namespace) -> int:
     from octax_core.env import romstore
 
-    rows = romstore.rom_status(game_specs())
+    rows = romstore.rom_status(game_specs(two_player_only=True))
     if not rows:
         print("no games registered")
         return 0
@@ -61,7 +61,7 @@ def _cmd_roms_list(args: argparse.Namespace) -> int:
 def _cmd_roms_install(args: argparse.Namespace) -> int:
     from octax_core.env import romstore
 
-    specs = game_specs()
+    specs = game_specs(two_player_only=True)
     if args.if_missing:
         missing = [row.game_id for row in romstore.rom_status(specs) if not row.verified]
         if not missing:
@@ -77,7 +77,7 @@ def _cmd_roms_install(args: argparse.Namespace) -> int:
 def _cmd_roms_import(args: argparse.Namespace) -> int:
     from octax_core.env import romstore
 
-    specs = game_specs()
+    specs = game_specs(two_player_only=True)
     return _report_import(romstore.import_roms(args.path, specs, args.dest), specs, args.dest)
 
 

@@ -30,7 +30,7 @@ def store(tmp_path, monkeypatch):
 @pytest.fixture
 def fake_games(monkeypatch):
     specs = [make_spec("Brix", "Brix.ch8", BRIX), make_spec("Pong", "Pong (1 player).ch8", PONG)]
-    monkeypatch.setattr(cli_roms, "game_specs", lambda: specs)
+    monkeypatch.setattr(cli_roms, "game_specs", lambda two_player_only=False: specs)
     return specs
 
 
@@ -119,7 +119,7 @@ def test_roms_list_with_the_real_registry_and_shared_roms(octax_rom_dir, capsys,
     monkeypatch.setenv("OCTAX_ROM_DIR", str(octax_rom_dir))
     monkeypatch.setattr(romstore, "PROJECT_ROM_DIR", PROJECT_ROM_DIR)
     assert cli.main(["roms", "list"]) == 0
-    n = len(list_games())
+    n = len(set(list_games()) | set(list_games(players=2)))  # the two-player-only games' ROMs too
     assert f"{n}/{n} ROMs present and verified" in capsys.readouterr().out
 
 
@@ -131,7 +131,7 @@ def test_install_does_not_count_our_own_games_as_missing(tmp_path, capsys, monke
     project.mkdir()
     (project / "own.ch8").write_bytes(own_rom)
     monkeypatch.setattr(romstore, "PROJECT_ROM_DIR", project)
-    monkeypatch.setattr(cli_roms, "game_specs", lambda: [*fake_games, own])
+    monkeypatch.setattr(cli_roms, "game_specs", lambda two_player_only=False: [*fake_games, own])
 
     def wheel_of_two(specs, dest, version):
         target = romstore.user_rom_dir()
@@ -162,3 +162,12 @@ def _folder_with(folder: Path, files: dict) -> Path:
     for name, data in files.items():
         (folder / name).write_bytes(data)
     return folder
+
+
+def test_the_rom_commands_cover_the_two_player_only_games():
+    """Paddles (octax suite) is played by two only: `roms install` must still fetch its ROM."""
+    from octax_gym.cli.common import game_specs
+
+    ids = {spec.id for spec in game_specs(two_player_only=True)}
+    assert {"Paddles", "TankArchive", "UltimateTicTacToe"} <= ids
+    assert "Paddles" not in {spec.id for spec in game_specs()}
