@@ -40,7 +40,10 @@ the minibatch epochs, unchanged; examples/jax_training.py: the command line). Wh
   steps per game) with the same settings (`--baseline-num-envs` to give them another number of
   envs; the default is the same num_envs, so a single agent makes G times fewer updates of the same
   size), evaluated the same way, normalized the same way; writes `comparison.csv` (one row per game,
-  plus the IQM and the mean) and `comparison.png`, and prints the table.
+  plus the IQM and the mean) and `comparison.png`, and prints the table. A finished single-game run
+  already in `out_dir/single-<game>/` with the same settings is read, not trained again, so the
+  baselines can be trained apart (train_jax_ppo.py with the flags that config.json shows) and
+  `--compare-only` (no multi-task training: reads `final.csv`) writes the comparison.
 
 Writes `progress.csv` (one row per evaluation: per-game returns, normalized scores, IQM, per-game
 training returns and env-step shares, the PPO losses), `learning_curve.png` (per-game normalized
@@ -98,6 +101,7 @@ class Config(ppo.Config):
     redraw_games: bool = False
     single_baseline: bool = False
     baseline_num_envs: int = 0  # 0: num_envs
+    compare_only: bool = False
 
     @property
     def game_list(self) -> tuple[str, ...]:
@@ -414,31 +418,24 @@ def single_baseline(config: Config, out_dir: Path, multi_rows: Sequence[dict], g
     comparison.csv and comparison.png. Returns their paths, rows and the two IQMs."""
     names = [r["game"] for r in multi_rows]
     specs = list(names) if games is None else list(games)
-    per_game = config.steps_per_game
-    num_envs = config.baseline_num_envs or config.num_envs
     rows = []
     for g, game in enumerate(names):
-        single = ppo.Config(
-            game=game, total_steps=per_game, num_envs=num_envs, num_steps=config.num_steps,
-            update_epochs=config.update_epochs,
-            num_minibatches=min(config.num_minibatches, num_envs * config.num_steps),
-            learning_rate=config.learning_rate, anneal_lr=config.anneal_lr, gamma=config.gamma,
-            max_grad_norm=config.max_grad_norm, seed=config.seed,
-            eval_every=config.eval_every // len(names) if config.eval_every else 0, eval_envs=config.eval_envs,
-            eval_max_steps=config.eval_max_steps, env_overrides=config.env_overrides, gae_lambda=config.gae_lambda,
-            clip_eps=config.clip_eps, clip_value_loss=config.clip_value_loss, vf_coef=config.vf_coef,
-            ent_coef=config.ent_coef)
-        print(f"single-game baseline {g + 1}/{len(names)}: PPO on {game}, {single.num_updates * single.batch_size:,} "
-              f"steps, {num_envs} envs", flush=True)
-        result = ppo.train(single, out_dir / f"single-{game}", game=specs[g],
-                           rom=None if roms is None else roms[g], progress=progress)
+        single = single_config(config, game, len(names))
+        final_return = _finished_single_run(out_dir / f"single-{game}", single)
+        if final_return is None:
+            print(f"single-game baseline {g + 1}/{len(names)}: PPO on {game}, {single.num_updates * single.batch_size:,} "
+                  f"steps, {single.num_envs} envs", flush=True)
+            final_return = ppo.train(single, out_dir / f"single-{game}", game=specs[g],
+                                     rom=None if roms is None else roms[g], progress=progress)["final_eval_mean_return"]
+        else:
+            print(f"single-game baseline {g + 1}/{len(names)}: {game}, reusing {out_dir / f'single-{game}'}")
         multi = multi_rows[g]
         rows.append({"game": game, "steps_per_game": single.num_updates * single.batch_size,
                      "random_ref": multi["random_ref"], "reference": multi["reference"],
                      "multi_return": multi["eval_return"],
-                     "single_return": round(result["final_eval_mean_return"], 4),
+                     "single_return": round(final_return, 4),
                      "multi_normalized": multi["normalized"],
-                     "single_normalized": round(normalized(game, result["final_eval_mean_return"]), 4)})
+                     "single_normalized": round(normalized(game, final_return), 4)})
     multi_iqm, multi_mean = aggregate([r["multi_normalized"] for r in rows])
     single_iqm, single_mean = aggregate([r["single_normalized"] for r in rows])
     table = rows + [{"game": "IQM", "multi_normalized": round(multi_iqm, 4), "single_normalized": round(single_iqm, 4)},
@@ -451,6 +448,48 @@ def single_baseline(config: Config, out_dir: Path, multi_rows: Sequence[dict], g
     print(jax_training_table(table, COMPARISON_COLUMNS))
     return {"comparison_csv": path, "comparison_png": png, "comparison_rows": rows,
             "single_iqm": single_iqm, "single_mean": single_mean}
+
+
+def single_config(config: Config, game: str, num_games: int) -> ppo.Config:
+    """The single-game baseline's settings for `game`: the multi-task run's, with total_steps / G
+    steps (the multi-task agent's steps per game), `baseline_num_envs` envs and evaluations every
+    eval_every / G steps (so at the same steps per game)."""
+    num_envs = config.baseline_num_envs or config.num_envs
+    return ppo.Config(
+        game=game, total_steps=config.steps_per_game, num_envs=num_envs, num_steps=config.num_steps,
+        update_epochs=config.update_epochs,
+        num_minibatches=min(config.num_minibatches, num_envs * config.num_steps),
+        learning_rate=config.learning_rate, anneal_lr=config.anneal_lr, gamma=config.gamma,
+        max_grad_norm=config.max_grad_norm, seed=config.seed,
+        eval_every=config.eval_every // num_games if config.eval_every else 0, eval_envs=config.eval_envs,
+        eval_max_steps=config.eval_max_steps, env_overrides=config.env_overrides, gae_lambda=config.gae_lambda,
+        clip_eps=config.clip_eps, clip_value_loss=config.clip_value_loss, vf_coef=config.vf_coef,
+        ent_coef=config.ent_coef)
+
+
+def _finished_single_run(run_dir: Path, single: "ppo.Config") -> Optional[float]:
+    """The last evaluation's mean return of a finished single-game run in `run_dir` made with the
+    same settings as `single` (config.json), or None: a run to train (none there, or another one)."""
+    try:
+        saved = json.loads((run_dir / "config.json").read_text())
+        rows = list(csv.DictReader(open(run_dir / "progress.csv")))
+    except (OSError, ValueError):
+        return None
+    wanted = json.loads(json.dumps(dataclasses.asdict(single), default=str))
+    same = all(saved.get(k) == v for k, v in wanted.items() if k != "env_overrides")
+    if not same or not rows or int(rows[-1]["step"]) != single.num_updates * single.batch_size:
+        return None
+    return float(rows[-1]["eval_mean_return"])
+
+
+def compare(config: Config, out_dir, games=None, roms=None, progress: bool = True) -> dict:
+    """`--compare-only`: the multi-task run already in `out_dir` (its final.csv) against the
+    single-game agents (`single_baseline`: those already in `out_dir/single-<game>/` with the
+    same settings are read, the others trained)."""
+    out_dir = Path(out_dir)
+    with open(out_dir / "final.csv") as f:
+        rows = [{k: (v if k == "game" else float(v)) for k, v in row.items()} for row in csv.DictReader(f)]
+    return single_baseline(config, out_dir, rows, games, roms, progress)
 
 
 def _write_csv(path: Path, columns: Sequence[str], rows: Sequence[dict]) -> Path:
@@ -570,6 +609,8 @@ HELP = {
     "redraw_games": "draw each new episode's game uniformly (the mix's autoreset) instead of fixed lanes",
     "single_baseline": "then train one PPO agent per game for total_steps / G steps and write comparison.csv",
     "baseline_num_envs": "envs of each single-game agent; 0: num_envs",
+    "compare_only": "no training: compare --out-dir's finished multi-task run with the single-game agents "
+                    "(finished ones in out-dir/single-<game> with the same settings are reused, others trained)",
 }
 
 
@@ -596,6 +637,10 @@ def main(argv: Optional[Sequence[str]] = None) -> dict:
     config, out_dir = jax_training.parse_args(Config, HELP, __doc__.split("\n\n")[0], "runs/jax_multitask",
                                               _join_games(argv))
     print(f"multi-task PPO on {', '.join(config.game_list)}: {config}")
+    if config.compare_only:
+        summary = compare(config, out_dir)
+        print(f"wrote {summary['comparison_csv']} and {summary['comparison_png']}")
+        return summary
     summary = train(config, out_dir)
     print(f"wrote {summary['csv']}, {summary['png']} and {summary['final_csv']}"
           + (f", {summary['comparison_csv']}" if "comparison_csv" in summary else ""))

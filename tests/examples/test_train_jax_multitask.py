@@ -182,3 +182,31 @@ def test_normalized_scores_of_real_games():
     iqm, mean = mt.aggregate([0.0, 1.0, 2.0, 3.0, math.nan])
     assert iqm == pytest.approx(1.5) and mean == pytest.approx(1.5)
     assert all(g in octax_core.list_games() for g in mt.DEFAULT_GAMES)
+
+
+def test_compare_only_reads_finished_single_runs(runs, tmp_path):
+    """--compare-only: the multi-task run's final.csv against single-game runs already on disk
+    with the baseline's settings (none trained here); a run with other settings would be retrained."""
+    import json
+    import shutil
+
+    (out, _), _ = runs
+    shutil.copy(out / "final.csv", tmp_path / "final.csv")
+    returns = {"Counter": 24.0, "CounterTwo": 16.0}
+    for game, value in returns.items():
+        single = mt.single_config(TINY, game, 2)
+        assert (single.total_steps, single.num_envs, single.eval_every) == (64, 8, 32)
+        d = tmp_path / f"single-{game}"
+        d.mkdir()
+        (d / "config.json").write_text(json.dumps({"algorithm": "PPO", **dataclasses.asdict(single)}, default=str))
+        (d / "progress.csv").write_text(f"step,eval_mean_return\n0,1.0\n64,{value}\n")
+        assert mt._finished_single_run(d, single) == value
+        assert mt._finished_single_run(d, dataclasses.replace(single, num_envs=16)) is None
+    summary = mt.compare(TINY, tmp_path, games=GAMES, progress=False)
+    rows = _rows(tmp_path / "comparison.csv")
+    assert [r["game"] for r in rows] == ["Counter", "CounterTwo", "IQM", "mean"]
+    assert [float(r["single_return"]) for r in rows[:2]] == [24.0, 16.0]
+    final = _rows(out / "final.csv")
+    assert [float(r["multi_return"]) for r in rows[:2]] == [float(r["eval_return"]) for r in final]
+    assert (tmp_path / "comparison.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert summary["comparison_rows"][0]["steps_per_game"] == 64
