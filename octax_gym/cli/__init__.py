@@ -15,6 +15,7 @@ imported inside the commands. This module only wires them up and reports errors.
     octax-gym roms install [--dest DIR]  get the octax==0.1.1 wheel with pip, install its ROMs
     octax-gym roms import PATH [--dest DIR]   the same from a folder, zip or wheel on disk
     octax-gym dataset collect GAME --dataset-id ID --steps N [--envs K]   a Minari dataset (docs/datasets.md)
+    octax-gym play GAME [--agent PATH] [--record ID] [--port N]   play in the browser (docs/play.md)
 """
 
 from __future__ import annotations
@@ -24,7 +25,7 @@ import sys
 import zipfile
 from typing import Optional, Sequence
 
-from octax_gym.cli import bench, dataset, games, octo, record, roms, trace
+from octax_gym.cli import bench, dataset, games, octo, play, record, roms, trace
 
 
 def main(argv: Optional[Sequence[str]] = None) -> int:
@@ -54,7 +55,7 @@ def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="octax-gym", description="CHIP-8, SUPER-CHIP and XO-CHIP games as reinforcement-learning environments.")
     commands = parser.add_subparsers(title="commands", metavar="COMMAND")
-    for module in (games, roms, record, bench, octo, trace, dataset):
+    for module in (games, roms, record, bench, octo, trace, dataset, play):
         module.add_commands(commands)
     return parser
 

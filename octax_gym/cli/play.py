@@ -1,0 +1,111 @@
+"""`octax-gym play`: play a game in the browser, watch an agent, record your episodes (docs/play.md).
+
+    octax-gym play Brix                               # prints http://127.0.0.1:PORT/
+    octax-gym play Duel --players human,scripted --open
+    octax-gym play Brix --agent runs/brix/params.msgpack
+    octax-gym play Brix --record octax/Brix-human-v0 --recorder alice
+
+Needs the `play` extra (aiohttp): pip install 'octax-gym[play]'. The server and JAX are imported
+only when the command runs.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+from pathlib import Path
+
+from octax_gym.cli.common import help_of  # noqa: F401  (the command modules' shared helpers)
+
+PLAY_HINT = "pip install 'octax-gym[play]'"
+
+
+def add_commands(commands: argparse._SubParsersAction) -> None:
+    play = commands.add_parser(
+        "play", help="play a game in your browser (a local web server; keys, agents, recording)",
+        description="Starts a local web server where the env runs and prints its address: the page shows the "
+                    "screen in the game's palette and takes the keyboard (Octo's layout: 1234/QWER/ASDF/ZXCV). "
+                    "Needs the play extra: " + PLAY_HINT + ". See docs/play.md.")
+    play.add_argument("game", metavar="GAME", help="game id (Brix) or Gymnasium id; two-player games too (Duel)")
+    play.add_argument("--port", type=int, default=0, metavar="N", help="port (default: a free one)")
+    play.add_argument("--host", default=None, metavar="H",
+                      help="address to bind (default 127.0.0.1, this machine only; anything else is reachable "
+                           "by others on your network: a warning is printed)")
+    play.add_argument("--open", action="store_true", help="open the page in the default browser")
+    play.add_argument("--seed", type=int, default=0, metavar="S", help="episode e is seeded S + e (default 0)")
+    play.add_argument("--agent", type=Path, metavar="PATH",
+                      help="a trained agent: params.msgpack from the JAX examples, or a Stable-Baselines3 zip")
+    play.add_argument("--players", metavar="P[,P]",
+                      help="who plays each seat: human, agent, scripted (two-player games), random "
+                           "(default: human, and for two players the agent, else the scripted player)")
+    play.add_argument("--record", metavar="DATASET_ID",
+                      help="store your episodes as a Minari dataset (namespace/name-vN; the datasets extra)")
+    play.add_argument("--recorder", default="human", metavar="NAME", help="who records, in the dataset's metadata")
+    play.add_argument("--data-path", type=Path, metavar="DIR", help="write the dataset under DIR "
+                                                                     "(default $MINARI_DATASETS_PATH or ~/.minari/datasets)")
+    play.add_argument("--overwrite", action="store_true", help="replace a dataset of that id")
+    play.add_argument("--max-episode-steps", type=int, metavar="M", help="truncate episodes after M steps")
+    play.set_defaults(func=_cmd_play)
+
+
+def _cmd_play(args: argparse.Namespace) -> int:
+    try:
+        import aiohttp  # noqa: F401
+    except ImportError as exc:
+        raise ImportError(f"octax-gym play needs aiohttp (the play extra): {PLAY_HINT} ({exc})") from exc
+    import logging
+
+    from octax_gym.game_names import resolve_spec
+    from octax_gym.play.server import PlayServer
+    from octax_gym.play.session import Session, is_two_player
+
+    logging.basicConfig(level=logging.INFO, format="%(asctime)s %(name)s %(levelname)s %(message)s")
+    if args.data_path is not None:
+        os.environ["MINARI_DATASETS_PATH"] = str(args.data_path.expanduser().resolve())
+    spec = resolve_spec(args.game)
+    two = is_two_player(spec)
+    num_actions = len(spec.seats.action_keys[0] if two else spec.action_keys) + 1
+    agent = None
+    if args.agent is not None:
+        from octax_gym.play.agents import load_agent
+        agent = load_agent(args.agent, num_actions)
+    players = None if args.players is None else [p.strip() for p in args.players.split(",")]
+    if players is not None and len(players) != (2 if two else 1):
+        raise ValueError(f"--players takes {2 if two else 1} name(s) for {spec.id}, got {args.players!r}")
+    env_options = {} if args.max_episode_steps is None else {"max_episode_steps": args.max_episode_steps}
+    recorder = None
+    if args.record is not None:
+        if two:
+            raise ValueError("--record stores one-player games (the human's episodes of a one-player env); "
+                             f"{spec.id} is a two-player game")
+        from octax_gym.play.record import Recorder
+        from octax_gym.vector import OctaxVectorEnv
+        probe = OctaxVectorEnv(spec.id, 1, **env_options)
+        recorder = Recorder(spec.id, args.record, observation_space=probe.single_observation_space,
+                            num_actions=num_actions, recorder=args.recorder, overwrite=args.overwrite,
+                            env_options=env_options)
+        probe.close()
+    print(f"compiling {spec.id} ...", file=sys.stderr)
+    session = Session(spec.id, seed=args.seed, agent=agent, players=players, recorder=recorder, **env_options)
+    host = args.host or "127.0.0.1"
+    if args.host is not None and args.host not in ("127.0.0.1", "localhost", "::1"):
+        print(f"octax-gym play: warning: binding {args.host}: anyone who can reach this address can play and "
+              "see the game; the page has no login", file=sys.stderr)
+    server = PlayServer(session, host=host, allow_any_host=args.host is not None)
+
+    def started(url: str) -> None:
+        print(f"octax-gym play: {spec.id} at {url}  (Ctrl-C to stop)", flush=True)
+        if args.open:
+            import webbrowser
+            webbrowser.open(url)
+
+    try:
+        server.run(args.port, on_start=started)
+    finally:
+        session.close()
+        if recorder is not None:
+            recorder.close()
+            print(f"recorded {recorder.episodes} episode(s), {recorder.steps} steps, as {recorder.dataset_id} "
+                  f"at {recorder.path}")
+    return 0
