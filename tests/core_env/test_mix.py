@@ -11,6 +11,7 @@ import pytest
 import octax_core
 
 from counter_game import COUNTER
+from random_rollouts import random_rollout
 
 # CHIP-8 games with different quirks (Blinky: schip), speeds (7 to 100 instructions a frame; 30
 # and 100 skip idle instructions), keys (1 to 6), survival rewards (GhostEscape) and frozen timers
@@ -19,25 +20,11 @@ OPTIONS = dict(noop_max=3, repeat_action_probability=0.25)
 STEPS = 40
 
 
-def _rollout(env, params, key, num_actions, game=None):
-    """An episode's first STEPS steps: random actions in 0..num_actions-1 drawn from `key`."""
-    obs, state = env.reset(key, params) if game is None else env.reset(key, params, game=game)
-
-    def one(carry, _):
-        state, key = carry
-        key, action_key, step_key = jax.random.split(key, 3)
-        action = jax.random.randint(action_key, (), 0, num_actions)
-        obs, state, reward, terminated, truncated, info = env.step(step_key, state, action, params)
-        return (state, key), (obs, reward, terminated, truncated, info["score"], info["lives"], info["episode_step"])
-
-    return obs, jax.lax.scan(one, (state, key), None, length=STEPS)[1]
-
-
 @pytest.fixture(scope="module")
 def mix():
     env, params = octax_core.make_mix(MIXED, **OPTIONS)
     # one compile for every game: the game and its action count are arguments
-    rollouts = jax.jit(jax.vmap(lambda k, n, g: _rollout(env, params, k, n, g), in_axes=(0, None, None)))
+    rollouts = jax.jit(jax.vmap(lambda k, n, g: random_rollout(env, params, k, n, STEPS, g), in_axes=(0, None, None)))
     return env, params, rollouts
 
 
@@ -46,7 +33,7 @@ def test_an_env_of_the_mix_plays_what_make_plays(mix, index):
     env, params, rollouts = mix
     single, single_params = octax_core.make(MIXED[index], **OPTIONS)
     keys = jax.random.split(jax.random.key(index), 3)
-    expected = jax.jit(jax.vmap(lambda k: _rollout(single, single_params, k, single.num_actions)))(keys)
+    expected = jax.jit(jax.vmap(lambda k: random_rollout(single, single_params, k, single.num_actions, STEPS)))(keys)
     got = rollouts(keys, single.num_actions, index)
     for want, have in zip(jax.tree.leaves(expected), jax.tree.leaves(got)):
         np.testing.assert_array_equal(want, have)

@@ -9,6 +9,8 @@ import pytest
 
 import octax_core
 
+from random_rollouts import random_rollout
+
 pytestmark = pytest.mark.slow
 
 STEPS = 25
@@ -17,24 +19,11 @@ BY_PLATFORM = {platform: [g for g in octax_core.list_games() if octax_core.get_s
                for platform in ("chip8", "schip", "xochip")}
 
 
-def _rollout(env, params, key, num_actions, game=None):
-    obs, state = env.reset(key, params) if game is None else env.reset(key, params, game=game)
-
-    def one(carry, _):
-        state, key = carry
-        key, action_key, step_key = jax.random.split(key, 3)
-        action = jax.random.randint(action_key, (), 0, num_actions)
-        obs, state, reward, terminated, truncated, info = env.step(step_key, state, action, params)
-        return (state, key), (obs, reward, terminated, truncated, info["score"], info["lives"])
-
-    return obs, jax.lax.scan(one, (state, key), None, length=STEPS)[1]
-
-
 @pytest.fixture(scope="module", params=sorted(BY_PLATFORM))
 def platform_mix(request):
     games = BY_PLATFORM[request.param]
     env, params = octax_core.make_mix(games, **OPTIONS)
-    rollouts = jax.jit(jax.vmap(lambda k, n, g: _rollout(env, params, k, n, g), in_axes=(0, None, None)))
+    rollouts = jax.jit(jax.vmap(lambda k, n, g: random_rollout(env, params, k, n, STEPS, g), in_axes=(0, None, None)))
     return games, rollouts
 
 
@@ -43,7 +32,7 @@ def test_every_game_in_its_platforms_mix_plays_what_make_plays(platform_mix):
     keys = jax.random.split(jax.random.key(5), 2)
     for index, game in enumerate(games):
         single, params = octax_core.make(game, **OPTIONS)
-        expected = jax.jit(jax.vmap(lambda k: _rollout(single, params, k, single.num_actions)))(keys)
+        expected = jax.jit(jax.vmap(lambda k: random_rollout(single, params, k, single.num_actions, STEPS)))(keys)
         got = rollouts(keys, single.num_actions, index)
         for want, have in zip(jax.tree.leaves(expected), jax.tree.leaves(got)):
             np.testing.assert_array_equal(want, have, err_msg=game)
