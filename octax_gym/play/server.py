@@ -190,6 +190,7 @@ class PlayServer:
                 except asyncio.TimeoutError:
                     pass
                 next_tick = loop.time()
+                self.session.step_times.clear()  # the frame rate is of play, not of pauses
                 continue
             try:
                 message = self.session.step()

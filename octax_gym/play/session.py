@@ -99,6 +99,9 @@ class Session:
         self.history: collections.deque[StepRecord] = collections.deque(maxlen=HISTORY)
         self.step_times: collections.deque[float] = collections.deque(maxlen=151)
         self.step_seconds: collections.deque[float] = collections.deque(maxlen=150)
+        # Seconds from a key press reaching the server to the end of the step that played it.
+        self.key_wait: collections.deque[float] = collections.deque(maxlen=1000)
+        self._pressed_at: Optional[float] = None
         self._scripted = {}
         self.obs = self.info = None
         self.done = False
@@ -151,8 +154,10 @@ class Session:
             self.held.remove(key)
         if down:
             self.held.append(key)
-        if seq is not None:
-            self.seq = max(self.seq, seq)
+        if seq is not None and seq > self.seq:
+            self.seq = seq
+            if down:
+                self._pressed_at = time.perf_counter()
 
     def human_action(self, seat: int) -> int:
         """The action of the latest-pressed held key among the seat's keys, else 0 (no key)."""
@@ -208,6 +213,9 @@ class Session:
         if self.done:
             self._finish(cut=False)
         now = time.perf_counter()
+        if self._pressed_at is not None:
+            self.key_wait.append(now - self._pressed_at)
+            self._pressed_at = None
         self.step_seconds.append(now - start)
         self.step_times.append(now)
         return self.message()
@@ -266,7 +274,7 @@ class Session:
                 "frames": base64.b64encode(self.frames().tobytes()).decode("ascii"),
                 "score": [int(s) for s in score], "lives": lives, "reward": self.last_reward.tolist(),
                 "return": self.returns.tolist(), "actions": list(self.last_actions), "seq": self.seq,
-                "done": self.done}
+                "done": self.done, "fps": round(self.frames_per_second(), 1)}
 
     def hello(self) -> dict:
         """The game's description for the page."""

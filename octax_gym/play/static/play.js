@@ -47,7 +47,8 @@
     smallCtx = small.getContext("2d");
     image = smallCtx.createImageData(hello.width, hello.height);
     document.title = `${hello.title} · octax-gym play`;
-    $("title").textContent = `${hello.title} (${hello.game}, ${hello.platform})`;
+    $("title").textContent = hello.title;
+    $("status").textContent = `${hello.game} · ${hello.platform.toUpperCase()} · connected`;
     $("description").textContent = hello.description;
     $("recording").hidden = !hello.recording;
     const seats = $("seats");
@@ -126,6 +127,7 @@
     $("return").textContent = msg.return.map((r) => r.toFixed(0)).join(" : ");
     $("step").textContent = msg.step;
     $("episode").textContent = `${msg.episode} (${msg.seed})`;
+    if (msg.fps) $("fps").textContent = msg.fps.toFixed(1);
     overlay();
   }
 
