@@ -1,0 +1,165 @@
+"""`octax-gym play`'s agents (the JAX examples' params, SB3 zips), recording without a browser,
+and the command line (a real server process: it prints its address, serves the page, stops on
+Ctrl-C)."""
+
+from __future__ import annotations
+
+import os
+import signal
+import subprocess
+import sys
+import time
+import urllib.request
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from octax_gym.play.agents import actor_critic_logits, load_agent, q_values
+from octax_gym.play.session import Session
+
+REPO = Path(__file__).resolve().parents[2]
+GAME = "Dodge"
+
+
+@pytest.fixture(scope="module")
+def networks():
+    pytest.importorskip("flax", reason="the JAX examples' networks need flax (the train extra)")
+    sys.path.insert(0, str(REPO / "examples"))
+    try:
+        import jax_networks
+    finally:
+        sys.path.remove(str(REPO / "examples"))
+    return jax_networks
+
+
+@pytest.mark.parametrize("kind", ["ppo", "pqn"])
+def test_jax_params_play_as_the_examples_network(networks, kind, tmp_path):
+    import flax.serialization
+    import jax
+
+    network = networks.ActorCritic(3) if kind == "ppo" else networks.QNetwork(3)
+    obs = jax.random.randint(jax.random.key(1), (3, 4, 32, 64), 0, 2).astype(np.uint8)
+    params = network.init(jax.random.key(0), obs)
+    path = tmp_path / "params.msgpack"
+    path.write_bytes(flax.serialization.to_bytes(params))
+    ours = (actor_critic_logits if kind == "ppo" else q_values)(
+        flax.serialization.msgpack_restore(path.read_bytes()), obs)
+    theirs = network.apply(params, obs)[0] if kind == "ppo" else network.apply(params, obs)
+    np.testing.assert_allclose(np.asarray(ours), np.asarray(theirs), rtol=1e-5, atol=1e-5)
+    agent = load_agent(path, 3)
+    assert [agent(np.asarray(o)) for o in obs] == list(np.asarray(theirs).argmax(-1))
+    # A one-player agent in a two-player seat gets the screens without the player plane.
+    assert agent(np.concatenate([np.asarray(obs[0]), np.ones((1, 32, 64), np.uint8)])) == agent(np.asarray(obs[0]))
+    with pytest.raises(ValueError, match="plays 3 actions"):
+        load_agent(path, 5)
+
+
+def test_bad_agent_files(tmp_path):
+    with pytest.raises(FileNotFoundError):
+        load_agent(tmp_path / "missing.msgpack", 3)
+    junk = tmp_path / "junk.msgpack"
+    junk.write_bytes(b"\x00not msgpack at all")
+    with pytest.raises((ValueError, ImportError)):
+        load_agent(junk, 3)
+
+
+def test_sb3_zip_plays(tmp_path):
+    pytest.importorskip("stable_baselines3", reason="SB3 zips need the sb3 extra")
+    from stable_baselines3 import PPO
+
+    from octax_gym.sb3 import make_sb3_vec_env, ppo_kwargs
+
+    venv = make_sb3_vec_env(GAME, 2)
+    model = PPO("CnnPolicy", venv, **{**ppo_kwargs(2, 1), "n_steps": 8, "batch_size": 16}, seed=0)
+    model.save(tmp_path / "agent.zip")
+    agent = load_agent(tmp_path / "agent.zip", venv.action_space.n)
+    obs = venv.reset()
+    assert agent(obs[0]) == int(model.predict(obs[:1], deterministic=True)[0][0])
+    session = Session(GAME, agent=agent)
+    assert session.players == ["agent"]
+    actions = {session.step()["actions"][0] for _ in range(10)}
+    assert actions <= {0, 1, 2}
+    session.close()
+    venv.close()
+
+
+def test_recorded_human_episodes_replay(tmp_path, monkeypatch):
+    pytest.importorskip("minari", reason="recording needs the datasets extra")
+    from octax_gym.datasets import episode_seed
+    from octax_gym.play.record import Recorder
+    from octax_gym.vector import OctaxVectorEnv
+
+    monkeypatch.setenv("MINARI_DATASETS_PATH", str(tmp_path))
+    probe = OctaxVectorEnv(GAME, 1)
+    recorder = Recorder(GAME, "test/Dodge-human-v0", observation_space=probe.single_observation_space,
+                        num_actions=3, recorder="pytest")
+    session = Session(GAME, seed=40, recorder=recorder, max_episode_steps=30)
+    left, right = session.seat_keys[0]
+    for t in range(40):                         # episode 0 runs to its truncation at 30 steps
+        session.key(left if t % 10 < 5 else right, True)
+        session.step()
+        session.key(left, False)
+        session.key(right, False)
+    assert session.done
+    session.reset()
+    for _ in range(7):                          # episode 1: reset after 7 steps, stored cut
+        session.key(right, True)
+        session.step()
+    session.reset()
+    session.set_player(0, "random")             # episode 2: not the human's, left out
+    for _ in range(5):
+        session.step()
+    session.close()
+    dataset = recorder.close()
+    assert dataset.total_episodes == 2 and dataset.total_steps == 37
+    env = dataset.recover_environment()
+    for episode, seed, length in zip(dataset.iterate_episodes(), (40, 41), (30, 7)):
+        assert episode_seed(dataset, episode.id) == seed and len(episode.actions) == length
+        assert episode.truncations[-1]
+        obs, _ = env.reset(seed=seed)
+        assert np.array_equal(obs, episode.observations[0])
+        for t, action in enumerate(episode.actions):
+            obs, reward, *_ = env.step(int(action))
+            assert np.array_equal(obs, episode.observations[t + 1]) and reward == episode.rewards[t]
+    assert set(episode.infos) == {"score", "lives", "episode_step"}
+    _, info = probe.reset(seed=0)
+    for name in ("score", "lives", "episode_step"):  # the env's own dtypes, as collect_dataset stores them
+        assert episode.infos[name].dtype == info[name].dtype
+
+
+def test_cli_parser_and_errors(capsys):
+    from octax_gym.cli import main
+
+    with pytest.raises(SystemExit):
+        main(["play", "--help"])
+    out = capsys.readouterr().out
+    assert "--agent" in out and "--record" in out and "--host" in out
+    assert main(["play", "NoSuchGame"]) == 1
+    assert main(["play", "Duel", "--record", "x/Duel-v0"]) == 1
+    assert "two-player" in capsys.readouterr().err
+    assert main(["play", GAME, "--players", "human,human"]) == 1
+
+
+def test_cli_serves_and_stops_on_ctrl_c():
+    pytest.importorskip("aiohttp", reason="octax-gym play needs the play extra")
+    env = {**os.environ, "PYTHONUNBUFFERED": "1"}
+    process = subprocess.Popen([sys.executable, "-m", "octax_gym", "play", GAME, "--seed", "3"], cwd=REPO, env=env,
+                               stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        line = ""
+        deadline = time.monotonic() + 120
+        while "http://" not in line and time.monotonic() < deadline:
+            line = process.stdout.readline()
+            if not line and process.poll() is not None:
+                break
+        assert "http://127.0.0.1:" in line, process.stderr.read() if process.poll() is not None else line
+        url = line[line.index("http://"):].split()[0]
+        with urllib.request.urlopen(url, timeout=10) as response:
+            assert response.status == 200 and b"play.js" in response.read()
+        process.send_signal(signal.SIGINT)
+        assert process.wait(timeout=30) == 0
+    finally:
+        if process.poll() is None:
+            process.kill()
+            process.wait()
