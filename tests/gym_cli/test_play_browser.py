@@ -217,7 +217,7 @@ def test_play_in_the_browser(browser, recorded, shots):
           f"{1000 * np.median(session.key_wait):.0f} ms; server {fps:.1f} frames/s; step compute median "
           f"{1000 * np.median(session.step_seconds):.2f} ms")
     assert len(latencies) >= 10 and np.median(latencies) < 150
-    assert 55 <= fps <= 61
+    assert 54 <= fps <= 61  # 60 frames/s, a 10% margin for a loaded CI machine
 
     # Recording: stop the server (the episode in play is written, cut), then replay every episode.
     handle.stop()

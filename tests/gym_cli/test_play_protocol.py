@@ -156,7 +156,7 @@ def test_page_gets_the_game_and_frames_at_60_per_second(live):
     print(f"\nserver: {steps_per_s:.2f} steps/s received by a client = {4 * steps_per_s:.1f} frames/s; "
           f"the session's own clock: {server_fps:.1f} frames/s; step compute median "
           f"{1000 * np.median(live.server.session.step_seconds):.2f} ms")
-    assert 14.0 <= steps_per_s <= 15.5 and 56.0 <= server_fps <= 61.0
+    assert 13.5 <= steps_per_s <= 15.5 and 54.0 <= server_fps <= 61.0  # 60 frames/s, a 10% margin for a loaded CI machine
     assert last["step"] > first["step"]
 
 
