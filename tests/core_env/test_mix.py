@@ -103,7 +103,7 @@ def test_per_game_episode_lengths_are_params(mix):
 
 
 def test_bad_mixes_are_named_errors():
-    with pytest.raises(ValueError, match="non-empty list of games; valid ids: .*Pong"):
+    with pytest.raises(ValueError, match=r"non-empty list of games or a named mix \(octax16\); valid ids: .*Pong"):
         octax_core.make_mix([])
     with pytest.raises(ValueError, match="non-empty list of games"):
         octax_core.make_mix("Pong")

@@ -54,6 +54,7 @@ Episodes are cut at 4,500 steps (5 minutes).
 
 import jax
 import jax.numpy as jnp
+import numpy as np
 
 from octax_core.env.games._own import level_specs, own_game_spec
 from octax_core.env.games.spec import Seats, register_value
@@ -61,10 +62,12 @@ from octax_core.env.games.spec import Seats, register_value
 X1, Y1, SCORE1, SCORE2, X2, Y2, DIR1, DIR2, GAME_OVER = 3, 4, 5, 6, 7, 8, 9, 10, 14
 WIN = 5
 UP, LEFT, RIGHT, DOWN = 0, 1, 2, 3  # the ROM's headings: a heading and its way back sum to 3
-_STEP = jnp.array([[0, -1], [-1, 0], [1, 0], [0, 1]])  # (dx, dy) per heading
-_ACTION = jnp.array([1, 3, 4, 2])  # the action whose key asks for each heading
+# numpy, not jnp: a module of the registry must not start JAX's backend at import (a user sets the
+# device count after `import octax_core`)
+_STEP = np.array([[0, -1], [-1, 0], [1, 0], [0, 1]])  # (dx, dy) per heading
+_ACTION = np.array([1, 3, 4, 2])  # the action whose key asks for each heading
 LOOKAHEAD = 12
-_PREFERENCE = (jnp.array([2, 0, 3, 1]), jnp.array([2, 3, 0, 1]))  # per seat, by heading (higher first)
+_PREFERENCE = (np.array([2, 0, 3, 1]), np.array([2, 3, 0, 1]))  # per seat, by heading (higher first)
 
 _LEVELS = (  # level: pairs of obstacles
     (1, 0),
@@ -99,15 +102,16 @@ def scripted_policy(state, seat: int) -> jax.Array:
     ahead = jnp.arange(1, LOOKAHEAD + 1)
 
     def free_run(h):
-        lit = jax.vmap(lambda k: _lit(state, x + k * _STEP[h, 0], y + k * _STEP[h, 1]))(ahead)
+        step = jnp.asarray(_STEP)[h]
+        lit = jax.vmap(lambda k: _lit(state, x + k * step[0], y + k * step[1]))(ahead)
         return jnp.argmax(jnp.append(lit, True))  # cells before the first lit one
 
     runs = jax.vmap(free_run)(jnp.arange(4))
     # ties: the present heading, then inwards (player 1 right, player 2 left: mirror images), up, down
-    order = _PREFERENCE[seat]
+    order = jnp.asarray(_PREFERENCE[seat])
     value = jnp.where(jnp.arange(4) + heading == 3, -1, runs * 8 + (jnp.arange(4) == heading) * 4 + order)
     best = jnp.argmax(value)
-    return jnp.where(best == heading, 0, _ACTION[best]).astype(jnp.int32)
+    return jnp.where(best == heading, 0, jnp.asarray(_ACTION)[best]).astype(jnp.int32)
 
 
 SEATS = Seats(
