@@ -291,13 +291,6 @@ def _scroll_planes(surface, inputs):
     return jnp.where(selected[:, None, None], display.scroll(surface, dx, dy), surface)
 
 
-class _Sprite(NamedTuple):
-    """What a hires draw reads (see `_draw_hires`)."""
-
-    patterns: jax.Array  # (planes, 16) uint32, zero on planes not drawn and on machines not in hires
-    x: jax.Array
-    y: jax.Array
-    height: jax.Array
 
 
 def _draw(platform: Platform, quirks: Quirks, screen, grid, memory, fetched: Fetched, drawing):
@@ -320,15 +313,20 @@ def _draw(platform: Platform, quirks: Quirks, screen, grid, memory, fetched: Fet
     mask = display.sprite_mask(lores, c.vx & 63, c.vy & 31, height, display.LORES, quirks.clipping)
     lores_collision = display.collides(screen, mask)
     sprite = _Sprite(jnp.where(c.hires, patterns, jnp.uint32(0)), c.vx & 127, c.vy & 63, height)
-    grid, hires_collision = when_any(drawing & c.hires, _draw_hires(quirks.clipping), (grid, jnp.bool_(False)),
-                                     sprite)
+    # `when_any`'s work may close over constants only: a mix's per-machine clipping is an input
+    fixed = isinstance(quirks.clipping, bool)
+    grid, hires_collision = when_any(drawing & c.hires, _draw_hires(quirks.clipping if fixed else None),
+                                     (grid, jnp.bool_(False)), (sprite, None if fixed else quirks.clipping))
     return grid, jnp.where(c.hires, hires_collision, lores_collision), mask
 
 
-def _draw_hires(clipping: bool):
-    def draw(operands, sprite: _Sprite):
-        grid, _ = operands
-        mask = display.sprite_mask(sprite.patterns, sprite.x, sprite.y, sprite.height, display.HIRES, clipping)
+def _draw_hires(clipping):
+    """The hires draw under `when_any`: `clipping` a constant, or None to read the machine's own
+    from the inputs (a mix of profiles)."""
+    def draw(operands, inputs):
+        (grid, _), (sprite, own_clipping) = operands, inputs
+        clip = clipping if own_clipping is None else own_clipping
+        mask = display.sprite_mask(sprite.patterns, sprite.x, sprite.y, sprite.height, display.HIRES, clip)
         return grid ^ mask, display.collides(grid, mask)
     return draw
 
