@@ -39,6 +39,7 @@ def test_an_env_of_the_mix_plays_what_make_plays(mix, index):
         np.testing.assert_array_equal(want, have)
 
 
+@pytest.mark.slow  # steps eight single envs eagerly beside the batch (a minute); each game's own test above is fast
 def test_one_batch_plays_every_game_at_once(mix):
     env, params, _ = mix
     games = jnp.arange(len(MIXED))
