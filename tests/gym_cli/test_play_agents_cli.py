@@ -146,15 +146,15 @@ def test_cli_serves_and_stops_on_ctrl_c(tmp_path):
     env = {**os.environ, "PYTHONUNBUFFERED": "1"}
     # stderr (the server's log) goes to a file: a pipe nobody reads could fill and block the server
     log = open(tmp_path / "stderr.log", "w+")
+    out = open(tmp_path / "stdout.log", "w+")  # a file too: nothing the server prints can block it
     process = subprocess.Popen([sys.executable, "-m", "octax_gym", "play", GAME, "--seed", "3"], cwd=REPO, env=env,
-                               stdout=subprocess.PIPE, stderr=log, text=True)
+                               stdout=out, stderr=log, text=True)
     try:
         line = ""
         deadline = time.monotonic() + 120
-        while "http://" not in line and time.monotonic() < deadline:
-            line = process.stdout.readline()
-            if not line and process.poll() is not None:
-                break
+        while "http://" not in line and time.monotonic() < deadline and process.poll() is None:
+            time.sleep(0.2)
+            line = next((l for l in (tmp_path / "stdout.log").read_text().splitlines() if "http://" in l), "")
         assert "http://127.0.0.1:" in line, (tmp_path / "stderr.log").read_text()
         url = line[line.index("http://"):].split()[0]
         with urllib.request.urlopen(url, timeout=10) as response:
@@ -167,3 +167,4 @@ def test_cli_serves_and_stops_on_ctrl_c(tmp_path):
             process.kill()
             process.wait()
         log.close()
+        out.close()
