@@ -73,14 +73,22 @@ class ConvTorso(nn.Module):
 
 
 class ActorCritic(nn.Module):
-    """PPO's network: ConvTorso, then separate actor and critic heads of one 256-unit ReLU layer each."""
+    """PPO's network: ConvTorso, then separate actor and critic heads of one 256-unit ReLU layer each.
+
+    It also reads (frames, game) pairs (the multi-task example): with `num_games` > 0 the game's
+    one-hot joins the torso's features before the heads, with 0 the game is not read.
+    """
 
     num_actions: int
+    num_games: int = 0
 
     @nn.compact
-    def __call__(self, obs: jax.Array) -> tuple[jax.Array, jax.Array]:
+    def __call__(self, obs) -> tuple[jax.Array, jax.Array]:
         """Returns logits (B, num_actions) and values (B,)."""
-        features = ConvTorso()(obs)
+        frames, game = obs if isinstance(obs, tuple) else (obs, None)
+        features = ConvTorso()(frames)
+        if self.num_games:
+            features = jnp.concatenate([features, jax.nn.one_hot(game, self.num_games, dtype=features.dtype)], -1)
         # Orthogonal init as in CleanRL: small policy outputs start the policy near uniform.
         actor = nn.relu(nn.Dense(HIDDEN, kernel_init=orthogonal(math.sqrt(2)))(features))
         logits = nn.Dense(self.num_actions, kernel_init=orthogonal(0.01))(actor)

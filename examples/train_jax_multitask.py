@@ -72,7 +72,7 @@ import octax_core
 import jax_training
 import jax_update
 import train_jax_ppo as ppo
-from jax_networks import HIDDEN, ConvTorso, orthogonal
+from jax_networks import ActorCritic
 from octax_gym import scores
 
 NEG = -1e9  # the logit of an action the game's mask closes
@@ -160,26 +160,11 @@ def lane_games(num_envs: int, num_games: int) -> jax.Array:
 
 # --- the network --------------------------------------------------------------------------------
 
-class MultiTaskActorCritic(nn.Module):
-    """The PPO example's network (`jax_networks.ActorCritic`: the paper's CNN torso, separate
-    256-unit actor and critic heads) on (frames, game) pairs: with `game_input`, the game's one-hot
-    joins the torso's 1,024 features before the heads; without, the game is not read."""
-
-    num_actions: int
-    num_games: int
-    game_input: bool = True
-
-    @nn.compact
-    def __call__(self, obs) -> tuple[jax.Array, jax.Array]:
-        frames, game = obs
-        features = ConvTorso()(frames)
-        if self.game_input:
-            features = jnp.concatenate([features, jax.nn.one_hot(game, self.num_games, dtype=features.dtype)], -1)
-        actor = nn.relu(nn.Dense(HIDDEN, kernel_init=orthogonal(math.sqrt(2)))(features))
-        logits = nn.Dense(self.num_actions, kernel_init=orthogonal(0.01))(actor)
-        critic = nn.relu(nn.Dense(HIDDEN, kernel_init=orthogonal(math.sqrt(2)))(features))
-        value = nn.Dense(1, kernel_init=orthogonal(1.0))(critic)
-        return logits, value[:, 0]
+def MultiTaskActorCritic(num_actions: int, num_games: int, game_input: bool = True) -> nn.Module:
+    """The PPO example's network (`jax_networks.ActorCritic`) on (frames, game) pairs: with
+    `game_input`, the game's one-hot joins the torso's features before the heads; without, the
+    game is not read."""
+    return ActorCritic(num_actions, num_games if game_input else 0)
 
 
 class Masked(nn.Module):
