@@ -24,7 +24,9 @@ FAST_GAMES = ["Pong", "Brix", "SuperPong", "Snek", "Danm8ku", "Piper", "SuperOct
 SLOW_GAMES = [g for g in octax_core.list_games() if g not in FAST_GAMES]
 
 
-@functools.lru_cache(maxsize=None)
+# Two entries: a test's two rollouts (skip_idle on and off). Keeping every game's compiled programs
+# alive through the whole-registry slow test grew a worker past what CI's machine holds.
+@functools.lru_cache(maxsize=2)
 def rollout(game: str, skip_idle: bool):
     own = make_config(octax_core.get_spec(game))[0].instructions_per_frame
     ipf = own if own >= idle.SKIP_FROM else 4 * own
