@@ -56,6 +56,7 @@ class RunConfig:
     eval_every: int = 131_072  # env steps (the paper's); 0: only at the start and the end
     eval_envs: int = 128  # one episode each (the paper's 128 parallel envs)
     eval_max_steps: Optional[int] = None  # step cap per eval; None: the env's max_episode_steps
+    save_at_evals: bool = False  # also write the params at every evaluation (checkpoints/params-step<N>...)
     env_overrides: tuple[tuple[str, Any], ...] = ()  # octax_core.make overrides, e.g. max_episode_steps
 
     @property
@@ -253,14 +254,24 @@ def train(config: RunConfig, make_train: Callable, out_dir, game=None, rom=None,
     start = time.perf_counter()
     bar = tqdm(total=config.num_updates * config.batch_size * seeds, unit="step", unit_scale=True,
                disable=not progress, desc=f"{trainer.name} {env.spec.id}" + (f" x{seeds}" if seeds > 1 else ""))
-    runner, train_s, rows = _loop(config, trainer, update, runner, evaluate_policy, eval_keys, log, bar, start)
+
+    def save_params(params, folder: Path, stem: str) -> list[Path]:
+        paths = []
+        for i, seed in enumerate(config.seeds):
+            path = folder / (f"{stem}.msgpack" if seeds == 1 else f"{stem}-seed{seed}.msgpack")
+            path.write_bytes(flax.serialization.to_bytes(jax.tree.map(lambda x: x[i], params)))
+            paths.append(path)
+        return paths
+
+    checkpoint = None
+    if config.save_at_evals:
+        (out_dir / "checkpoints").mkdir(exist_ok=True)
+        checkpoint = lambda step, params: save_params(params, out_dir / "checkpoints", f"params-step{step}")  # noqa: E731
+    runner, train_s, rows = _loop(config, trainer, update, runner, evaluate_policy, eval_keys, log, bar, start,
+                                  checkpoint)
     bar.close()
     params = trainer.params(runner)
-    param_paths = []
-    for i, seed in enumerate(config.seeds):
-        path = out_dir / ("params.msgpack" if seeds == 1 else f"params-seed{seed}.msgpack")
-        path.write_bytes(flax.serialization.to_bytes(jax.tree.map(lambda x: x[i], params)))
-        param_paths.append(path)
+    param_paths = save_params(params, out_dir, "params")
     steps_per_s = config.num_updates * config.batch_size * seeds / train_s
     final = np.array([row["eval_mean_return"] for row in rows])
     print(f"training speed: {steps_per_s:,.0f} env steps/s over {seeds} seed(s), "
@@ -276,8 +287,9 @@ def train(config: RunConfig, make_train: Callable, out_dir, game=None, rom=None,
 
 
 def _loop(config: RunConfig, trainer: Trainer, update, runner, evaluate_policy, eval_keys, log: "RunLog",
-          bar, start: float):
-    """The updates, with an evaluation of every seed every `eval_every` steps and at both ends.
+          bar, start: float, checkpoint: Optional[Callable] = None):
+    """The updates, with an evaluation of every seed every `eval_every` steps and at both ends
+    (and `checkpoint(step, params)` after each, when given).
 
     Returns the runner, the seconds spent in updates, and the last evaluation's rows (one per seed).
     """
@@ -292,6 +304,8 @@ def _loop(config: RunConfig, trainer: Trainer, update, runner, evaluate_policy, 
             rows = log.add(i, i * config.batch_size, time.perf_counter() - start, train_s, returns, ended,
                            totals, trainer.host_metrics(i))
             bar.set_postfix(eval=f"{np.mean(returns):.2f}", random=f"{np.mean(log.random_means):.2f}")
+            if checkpoint is not None:
+                checkpoint(i * config.batch_size, trainer.params(runner))
             totals = {}
         if i == config.num_updates:
             return runner, train_s, rows
@@ -389,6 +403,8 @@ HELP = {
     "eval_every": "env steps between evaluations; 0: only at the start and the end",
     "eval_envs": "evaluation episodes (one per env) per seed, played to their end",
     "eval_max_steps": "step cap per evaluation; None: the env's max_episode_steps",
+    "save_at_evals": "also write the params at every evaluation, as checkpoints/params-step<N>[-seed<S>].msgpack "
+                     "(the dataset suite's medium policies come from these)",
 }
 ENV_FLAGS = {"max_episode_steps": int, "frames_per_step": int, "repeat_action_probability": float,
              "noop_max": int}

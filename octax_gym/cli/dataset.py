@@ -1,7 +1,8 @@
-"""`octax-gym dataset collect`: play a game in many lanes at once and write a Minari dataset.
+"""`octax-gym dataset collect` and `dataset suite`: play a game in many lanes at once and write a Minari dataset.
 
     octax-gym dataset collect Brix --dataset-id octax/Brix-random-v0 --steps 100000 --envs 64
     octax-gym dataset collect Pong --dataset-id octax/Pong-noop-v0 --steps 5000 --policy noop --data-path /tmp/minari
+    octax-gym dataset suite --runs runs/suite          # octax/<Game>/{random,medium,expert}-v0
 
 A thin layer over `octax_gym.datasets.collect_dataset`, which checks the arguments (its errors
 name the valid choices) and is imported only when the command runs: it brings JAX and Minari.
@@ -52,6 +53,31 @@ def add_commands(commands: argparse._SubParsersAction) -> None:
     collect.add_argument("--no-progress", action="store_true", help="no progress bar")
     collect.set_defaults(func=_cmd_collect)
 
+    from octax_gym.datasets import suite  # no JAX or Minari: names and defaults only
+
+    build = sub.add_parser(
+        "suite", help="collect the dataset suite (random, medium, expert per game) from trained policies",
+        description="Collects octax/<Game>/random-v0, medium-v0 and expert-v0 for the suite's games "
+                    f"({', '.join(suite.GAMES)}) from the PPO runs under --runs (examples/train_jax_ppo.py "
+                    "--save-at-evals --out-dir RUNS/<Game>; `make dataset-suite` trains and collects). "
+                    "Each dataset's metadata names its policy; the params are copied beside its data. "
+                    "Needs the datasets and train extras. See docs/datasets.md.")
+    build.add_argument("--runs", type=Path, required=True, metavar="DIR",
+                       help="the training runs, one folder per game (DIR/Airplane/params.msgpack, ...)")
+    build.add_argument("--games", nargs="+", default=list(suite.GAMES), metavar="GAME",
+                       help=f"a subset of the suite's games (default: all of {' '.join(suite.GAMES)})")
+    build.add_argument("--kinds", nargs="+", default=list(suite.KINDS), metavar="KIND",
+                       help="a subset of random medium expert (default: all three)")
+    build.add_argument("--steps", type=int, default=suite.STEPS, metavar="N",
+                       help=f"steps per dataset (default {suite.STEPS:,})")
+    build.add_argument("--envs", type=int, default=suite.ENVS, metavar="K", help=f"lanes (default {suite.ENVS})")
+    build.add_argument("--seed", type=int, default=0, metavar="S", help="the first episode seed and the policies' seed")
+    build.add_argument("--data-path", type=Path, metavar="DIR",
+                       help=f"write under DIR instead of ${DATASETS_PATH_VARIABLE} (default ~/.minari/datasets)")
+    build.add_argument("--overwrite", action="store_true", help="replace datasets of those ids")
+    build.add_argument("--no-progress", action="store_true", help="no progress bars")
+    build.set_defaults(func=_cmd_suite)
+
 
 def _cmd_collect(args: argparse.Namespace) -> int:
     from octax_gym.datasets import collect_dataset
@@ -63,6 +89,20 @@ def _cmd_collect(args: argparse.Namespace) -> int:
                                  **env_options)
     print(f"wrote {result.dataset_id}: {result.episodes} episodes, {result.steps} steps in {result.seconds:.1f} s "
           f"({result.steps_per_second:,.0f} steps/s), {_megabytes(result.path):,.1f} MB at {result.path}")
+    return 0
+
+
+def _cmd_suite(args: argparse.Namespace) -> int:
+    from octax_gym.datasets.suite import build_suite
+
+    with _datasets_path(args.data_path):
+        results = build_suite(args.runs, args.games, args.kinds, steps=args.steps, num_envs=args.envs,
+                              seed=args.seed, overwrite=args.overwrite, progress=not args.no_progress)
+    for result in results:
+        returns = [float(sum(e.rewards)) for e in result.dataset.iterate_episodes()]
+        print(f"wrote {result.dataset_id}: {result.episodes} episodes, {result.steps} steps, mean return "
+              f"{sum(returns) / len(returns):.2f}, {_megabytes(result.path):,.1f} MB "
+              f"({result.steps_per_second:,.0f} steps/s)")
     return 0
 
 

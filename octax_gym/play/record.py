@@ -13,13 +13,15 @@ ends, so a crash loses at most the one in play.
 from __future__ import annotations
 
 import shutil
-import types
 from pathlib import Path
 from typing import Any, Optional
 
 import numpy as np
 
+from gymnasium import spaces
+
 from octax_gym import datasets
+from octax_gym.datasets import storage
 from octax_gym.game_names import resolve_env_id
 
 
@@ -27,8 +29,8 @@ class Recorder:
     def __init__(self, game: str, dataset_id: str, *, observation_space, num_actions: int,
                  recorder: str = "human", overwrite: bool = False, env_options: Optional[dict] = None,
                  description: Optional[str] = None):
-        minari = datasets._import_minari()
-        datasets._check_dataset_id(dataset_id)
+        minari = storage.import_minari()
+        storage.check_dataset_id(dataset_id)
         gym_id = resolve_env_id(game)
         path = minari.storage.get_dataset_path(dataset_id)
         if path.exists() and not overwrite:
@@ -41,10 +43,9 @@ class Recorder:
                     "description": description or (f"{gym_id}, played by a human ({recorder}) in the browser with "
                                                     "`octax-gym play --record`; episode seeds in the episode "
                                                     "metadata replay each episode")}
-        lanes = types.SimpleNamespace(observation_space=observation_space, num_actions=num_actions)
-        self._writer = datasets._Writer(minari, dataset_id, datasets.recovery_spec(gym_id, env_options or {}),
-                                        lanes, 1, metadata)
-        self._episode: Optional[datasets._Episode] = None
+        self._writer = storage.DatasetWriter(dataset_id, datasets.recovery_spec(gym_id, env_options or {}),
+                                             observation_space, spaces.Discrete(num_actions), 1, metadata)
+        self._episode: Optional[storage.EpisodeRecord] = None
         self.dataset = None
 
     @property
@@ -56,7 +57,7 @@ class Recorder:
         return self._writer.steps
 
     def start(self, seed: int, obs: np.ndarray, info: dict[str, Any]) -> None:
-        self._episode = datasets._Episode(seed, np.asarray(obs), info)
+        self._episode = storage.EpisodeRecord(seed, np.asarray(obs), info)
 
     def add(self, action: int, obs: np.ndarray, reward: float, terminated: bool, truncated: bool,
             info: dict[str, Any]) -> None:
@@ -69,8 +70,7 @@ class Recorder:
         episode, self._episode = self._episode, None
         if episode is None or not len(episode) or not keep:
             return
-        ended = episode.terminations[-1] or episode.truncations[-1]
-        self._writer.add(episode, cut=cut and not ended)
+        self._writer.add(episode, cut=cut and not episode.ended)
 
     def close(self):
         """Writes what is left; returns the `minari.MinariDataset`."""

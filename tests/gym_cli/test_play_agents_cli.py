@@ -15,7 +15,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from octax_gym.play.agents import actor_critic_logits, load_agent, q_values
+from octax_gym.jax_policy import actor_critic_logits, q_values
+from octax_gym.play.agents import load_agent
 from octax_gym.play.session import Session
 
 REPO = Path(__file__).resolve().parents[2]

@@ -58,10 +58,10 @@ def test_video_and_datasets_refuse_an_unknown_policy_with_the_same_error(tmp_pat
 
 
 def test_video_and_datasets_play_from_the_one_table():
-    from octax_gym import datasets
+    from octax_gym.datasets import collect
 
-    assert video.make_policy is datasets.make_policy is policies.make_policy
-    assert not hasattr(video, "POLICIES") and not hasattr(datasets, "POLICIES")
+    assert video.make_policy is collect.make_policy is policies.make_policy
+    assert not hasattr(video, "POLICIES") and not hasattr(collect, "POLICIES")
 
 
 @pytest.mark.parametrize("command", ["record", "trace", "dataset collect"])

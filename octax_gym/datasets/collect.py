@@ -23,7 +23,6 @@ import dataclasses
 import functools
 import shutil
 import time
-import warnings
 from pathlib import Path
 from typing import Any, Optional
 
@@ -40,12 +39,12 @@ from octax_gym import action_check, compiled_step
 from octax_gym.choices import check_names
 from octax_gym.compiled_step import GYM_ENV_OPTIONS, MAX_SEED
 from octax_gym.game_names import resolve_env_id
+from octax_gym.datasets.storage import DatasetWriter, EpisodeRecord, check_dataset_id, import_minari
 from octax_gym.policies import Act, Policy, check_policy, make_policy, policy_name
 
 # Finished episodes are written once they hold this many steps: ~160 MB of 32 x 64 frames (CHIP-8),
 # 4x that of 64 x 128 ones (SUPER-CHIP, XO-CHIP).
 FLUSH_STEPS = 20_000
-INSTALL_HINT = 'pip install "octax-gym[datasets]"'
 
 
 @dataclasses.dataclass(frozen=True)
@@ -68,7 +67,8 @@ def collect_dataset(env_id: str, dataset_id: str, num_steps: int, *, num_envs: i
                     policy: Policy = None, seed: int = 0, overwrite: bool = False, progress: bool = True,
                     author: Optional[str] = None, author_email: Optional[str] = None,
                     code_permalink: Optional[str] = None, description: Optional[str] = None,
-                    flush_steps: int = FLUSH_STEPS, **env_options) -> CollectResult:
+                    algorithm_name: Optional[str] = None, flush_steps: int = FLUSH_STEPS, compress: bool = True,
+                    extra_metadata: Optional[dict[str, Any]] = None, **env_options) -> CollectResult:
     """Plays `num_steps` env steps in `num_envs` lanes at once and writes them as a Minari dataset.
 
     Episodes end where the env ends them (terminated, or truncated at max_episode_steps); the
@@ -93,10 +93,15 @@ def collect_dataset(env_id: str, dataset_id: str, num_steps: int, *, num_envs: i
         seed: the first episode seed, 0 <= seed and seed + num_envs + num_steps <= 2**32.
         overwrite: replace a dataset of that id; otherwise an existing one is an error.
         progress: a tqdm progress bar on stderr.
-        author, author_email, code_permalink, description: Minari's metadata (the description
-            defaults to one naming the game, policy, lanes and seed).
+        author, author_email, code_permalink, description, algorithm_name: Minari's metadata (the
+            description defaults to one naming the game, policy, lanes and seed; algorithm_name to
+            the policy's name).
         flush_steps: finished episodes are written in groups of at least this many steps, which
             bounds the memory they hold.
+        compress: store the observations through HDF5's scale-offset and deflate filters (about
+            70x smaller; read back bit for bit by any HDF5 reader, `minari.load_dataset` included:
+            `octax_gym.datasets.storage`); False stores them plain.
+        extra_metadata: more keys for the dataset's metadata.json (JSON values), e.g. a policy card.
         **env_options: the env's options (`octax_gym.compiled_step.GYM_ENV_OPTIONS`: max_episode_steps,
             frames_per_step, noop_max, repeat_action_probability, ...); they are stored in the
             dataset's env spec, so `recover_environment()` builds the same env.
@@ -113,13 +118,13 @@ def collect_dataset(env_id: str, dataset_id: str, num_steps: int, *, num_envs: i
         TypeError: a policy returning actions that are not integers.
         ImportError: Minari (the `datasets` extra) is not installed.
     """
-    minari = _import_minari()
+    minari = import_minari()
     gym_id = resolve_env_id(env_id)
     check_int("num_steps", num_steps)
     check_int("num_envs", num_envs)
     check_int("seed", seed, minimum=0, maximum=MAX_SEED - num_envs - num_steps)
     check_int("flush_steps", flush_steps)
-    _check_dataset_id(dataset_id)
+    check_dataset_id(dataset_id)
     check_names("env option(s)", env_options, GYM_ENV_OPTIONS)
     check_policy(policy)
     path = minari.storage.get_dataset_path(dataset_id)
@@ -128,7 +133,7 @@ def collect_dataset(env_id: str, dataset_id: str, num_steps: int, *, num_envs: i
                          "(--overwrite) to replace it, or pick another name or version")
     lanes = _Lanes(gymnasium.spec(gym_id).kwargs["game"], num_envs, env_options)  # checks the options' values
     act = make_policy(policy, num_envs, lanes.num_actions, seed)
-    metadata = {"algorithm_name": policy_name(policy), "author": author, "author_email": author_email,
+    metadata = {"algorithm_name": algorithm_name or policy_name(policy), "author": author, "author_email": author_email,
                 "code_permalink": code_permalink,
                 "description": description or (f"{gym_id}, {policy_name(policy)} policy, {num_steps} steps from "
                                                f"{num_envs} lanes, episode seeds from {seed}: collected by "
@@ -137,7 +142,9 @@ def collect_dataset(env_id: str, dataset_id: str, num_steps: int, *, num_envs: i
         shutil.rmtree(path)
     try:
         start = time.perf_counter()
-        writer = _Writer(minari, dataset_id, recovery_spec(gym_id, env_options), lanes, flush_steps, metadata)
+        writer = DatasetWriter(dataset_id, recovery_spec(gym_id, env_options), lanes.observation_space,
+                               spaces.Discrete(lanes.num_actions), flush_steps, metadata,
+                               extra_metadata=extra_metadata, compress=compress)
         with tqdm(total=num_steps, desc=f"collecting {gym_id}", unit="step", disable=not progress) as bar:
             _collect(lanes, act, num_steps, seed, writer, bar)
         dataset = writer.close()
@@ -172,47 +179,13 @@ def episode_seed(dataset, episode_id: int) -> int:
 # --- the collection loop ---------------------------------------------------------------------
 
 
-class _Episode:
-    """One lane's running episode: its seed and what the env returned since the reset that
-    started it (numpy rows copied out of the batch, so a finished batch can be freed)."""
-
-    def __init__(self, seed: int, obs: np.ndarray, info: dict[str, Any]):
-        self.seed = seed
-        self.observations = [obs.copy()]
-        self.infos = {name: [value] for name, value in info.items()}
-        self.actions, self.rewards, self.terminations, self.truncations = [], [], [], []
-
-    def add(self, action, obs, reward, terminated, truncated, info: dict[str, Any]) -> None:
-        self.actions.append(action)
-        self.observations.append(obs.copy())
-        self.rewards.append(reward)
-        self.terminations.append(terminated)
-        self.truncations.append(truncated)
-        for name, value in info.items():
-            self.infos[name].append(value)
-
-    def __len__(self) -> int:
-        return len(self.actions)
-
-    def to_buffer(self, episode_buffer_class, cut: bool):
-        """A Minari `EpisodeBuffer`; `cut` marks an episode stopped by the end of collection
-        (truncated at its last step, which the env itself did not end)."""
-        truncations = np.array(self.truncations, np.bool_)
-        if cut:
-            truncations[-1] = True
-        return episode_buffer_class(
-            seed=self.seed, observations=np.stack(self.observations), actions=np.array(self.actions, np.int64),
-            rewards=np.array(self.rewards, np.float32), terminations=np.array(self.terminations, np.bool_),
-            truncations=truncations, infos={name: np.array(values) for name, values in self.infos.items()})
-
-
 def _collect(lanes: "_Lanes", act: Act, num_steps: int, seed: int,
-             writer: "_Writer", bar: tqdm) -> None:
+             writer: DatasetWriter, bar: tqdm) -> None:
     """Steps every lane at once until `num_steps` transitions are stored, starting a new episode
     in a lane, with the next unused seed, as soon as its episode ends."""
     num_envs = lanes.num_envs
     obs, info = lanes.start(seed)  # lane i: seed + i
-    episodes = [_Episode(seed + lane, obs[lane], _row(info, lane)) for lane in range(num_envs)]
+    episodes = [EpisodeRecord(seed + lane, obs[lane], _row(info, lane)) for lane in range(num_envs)]
     next_seed = seed + num_envs
     left = num_steps
     while left > 0:
@@ -228,9 +201,9 @@ def _collect(lanes: "_Lanes", act: Act, num_steps: int, seed: int,
             next_seed += 1
             if lane < used:
                 writer.add(episodes[lane], cut=False)
-                episodes[lane] = _Episode(int(seeds[lane]), obs[lane], _row(first_info, lane))
+                episodes[lane] = EpisodeRecord(int(seeds[lane]), obs[lane], _row(first_info, lane))
     for episode in episodes:
-        if len(episode) and not (episode.terminations[-1] or episode.truncations[-1]):
+        if len(episode) and not episode.ended:
             writer.add(episode, cut=True)
 
 
@@ -293,69 +266,3 @@ def _unmasked(info: dict) -> dict:
 def _row(info: dict, lane: int) -> dict[str, Any]:
     """One lane's info."""
     return {name: value[lane] for name, value in info.items()}
-
-
-class _Writer:
-    """Creates the dataset, then appends finished episodes in groups of at least `flush_steps`
-    steps, so memory holds one group at a time.
-
-    (A writer thread overlapping HDF5 writes with the steps measured no faster on 2 cores.)
-    """
-
-    def __init__(self, minari, dataset_id: str, env_spec, lanes: _Lanes, flush_steps: int,
-                 metadata: dict[str, Any]):
-        self._episode_buffer = minari.data_collector.EpisodeBuffer
-        self._flush_steps = flush_steps
-        self._pending: list = []  # EpisodeBuffers not yet written
-        self._pending_steps = 0
-        self.episodes = self.steps = 0
-        given = {name: value for name, value in metadata.items() if value is not None}
-        with warnings.catch_warnings():  # Minari's "author is None, recommended" notes: optional here
-            warnings.filterwarnings("ignore", message=r".*is set to None", category=UserWarning)
-            self._dataset = minari.create_dataset_from_buffers(
-                dataset_id, [], env=env_spec, observation_space=lanes.observation_space,
-                action_space=spaces.Discrete(lanes.num_actions), requirements=["octax-gym"], data_format="hdf5",
-                jpeg_encoding=False, **given)
-
-    def add(self, episode: _Episode, cut: bool) -> None:
-        self._pending.append(episode.to_buffer(self._episode_buffer, cut))
-        self._pending_steps += len(episode)
-        if self._pending_steps >= self._flush_steps:
-            self._flush()
-
-    def close(self):
-        """Writes what is left; returns the `MinariDataset`."""
-        self._flush()
-        return self._dataset
-
-    def _flush(self) -> None:
-        if self._pending:
-            self._dataset.update_dataset_from_buffer(self._pending)
-            self.episodes += len(self._pending)
-            self.steps += self._pending_steps
-        self._pending, self._pending_steps = [], 0
-
-
-# --- checks ----------------------------------------------------------------------------------
-
-
-def _import_minari():
-    try:
-        import h5py  # noqa: F401  (Minari's HDF5 storage; its own error would name minari[hdf5])
-        import minari
-        import minari.data_collector
-        import minari.storage
-    except ImportError as exc:
-        raise ImportError(f"octax_gym.datasets needs Minari with HDF5 (the datasets extra): "
-                          f"{INSTALL_HINT} ({exc})") from exc
-    return minari
-
-
-def _check_dataset_id(dataset_id) -> None:
-    from minari.dataset.minari_dataset import DATASET_ID_RE
-
-    match = DATASET_ID_RE.fullmatch(dataset_id) if isinstance(dataset_id, str) else None
-    if match is None or match.group("version") is None:
-        raise ValueError(f"dataset_id must look like 'namespace/name-v0' (Minari's format: an optional "
-                         f"namespace/, a name of letters, digits, '-' and '_', and a version -vN), "
-                         f"got {dataset_id!r}")

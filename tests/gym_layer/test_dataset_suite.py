@@ -1,0 +1,123 @@
+"""The dataset suite (octax_gym/datasets/suite.py): which checkpoint is medium and which expert,
+and a test-sized suite built from a fake training run whose params are a freshly initialised
+network of the examples (what the suite does with trained ones): three datasets per game, each
+naming its policy in its metadata with the params beside it."""
+
+from __future__ import annotations
+
+import csv
+import hashlib
+import json
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+minari = pytest.importorskip("minari")
+flax = pytest.importorskip("flax", reason="the suite's policies are the JAX examples' (the train extra)")
+
+from octax_gym import UnknownOptionError, jax_policy  # noqa: E402
+from octax_gym.datasets import suite  # noqa: E402
+
+REPO = Path(__file__).resolve().parents[2]
+
+
+def fake_run(folder: Path, evals: dict[int, float], random_return: float = 1.0, num_actions: int = 4,
+             params: bytes = b"") -> Path:
+    """A training run's files as `examples/train_jax_ppo.py --save-at-evals` writes them."""
+    (folder / "checkpoints").mkdir(parents=True)
+    (folder / "config.json").write_text(json.dumps({"algorithm": "PPO", "eval_envs": 64, "game": folder.name,
+                                                    "command": ["examples/train_jax_ppo.py", "--game", folder.name]}))
+    with open(folder / "progress.csv", "w", newline="") as file:
+        writer = csv.DictWriter(file, fieldnames=["seed", "step", "eval_mean_return", "random_mean_return"])
+        writer.writeheader()
+        for step, value in evals.items():
+            writer.writerow({"seed": 0, "step": step, "eval_mean_return": value, "random_mean_return": random_return})
+    for step in evals:
+        (folder / "checkpoints" / f"params-step{step}.msgpack").write_bytes(params or f"step {step}".encode())
+    (folder / "params.msgpack").write_bytes(params or b"final")
+    return folder
+
+
+def test_medium_is_the_checkpoint_nearest_a_third_of_the_way_and_expert_the_final_one(tmp_path):
+    # random 1, expert 10: a third of the way is 4; 3.5 is nearer than 5.0
+    run = fake_run(tmp_path / "Flak", {0: 1.0, 100: 2.0, 200: 3.5, 300: 5.0, 400: 9.0, 500: 10.0})
+    cards = suite.pick_policies(run)
+    assert cards["expert"].steps_trained == 500 and cards["expert"].eval_return == 10.0
+    assert cards["expert"].params_path == run / "params.msgpack"
+    assert cards["medium"].steps_trained == 200 and cards["medium"].eval_return == 3.5
+    assert cards["medium"].params_path == run / "checkpoints" / "params-step200.msgpack"
+    card = cards["medium"].metadata()
+    assert card["algorithm"] == "PPO" and card["random_return"] == 1.0 and card["eval_episodes"] == 64
+    assert card["params_sha256"] == hashlib.sha256(b"step 200").hexdigest()
+    assert "--game Flak" in card["training_command"]
+
+
+def test_a_missing_run_names_the_training_command(tmp_path):
+    with pytest.raises(FileNotFoundError, match="train_jax_ppo.py --save-at-evals"):
+        suite.pick_policies(tmp_path / "Airplane")
+    with pytest.raises(UnknownOptionError, match="Airplane"):
+        suite.build_suite(tmp_path, games=["Pong"])
+    with pytest.raises(UnknownOptionError, match="expert"):
+        suite.build_suite(tmp_path, games=["Flak"], kinds=["novice"])
+
+
+def test_a_test_sized_suite_names_its_policies_and_keeps_their_params(tmp_path, monkeypatch):
+    import jax
+
+    monkeypatch.setenv("MINARI_DATASETS_PATH", str(tmp_path / "minari"))
+    sys.path.insert(0, str(REPO / "examples"))
+    try:
+        import jax_networks
+    finally:
+        sys.path.remove(str(REPO / "examples"))
+    params = jax_networks.ActorCritic(4).init(jax.random.key(0), np.zeros((1, 4, 32, 64), np.uint8))
+    fake_run(tmp_path / "runs" / "Flak", {0: 10.0, 32768: 20.0, 65536: 40.0},
+             params=flax.serialization.to_bytes(params), random_return=10.0)
+    results = suite.build_suite(tmp_path / "runs", games=["Flak"], steps=40, num_envs=4, progress=False)
+    assert [r.dataset_id for r in results] == ["octax/Flak/random-v0", "octax/Flak/medium-v0", "octax/Flak/expert-v0"]
+    for result, kind in zip(results, suite.KINDS):
+        dataset = minari.load_dataset(result.dataset_id)
+        assert dataset.total_steps == 40
+        metadata = json.loads((result.path / "data" / "metadata.json").read_text())
+        assert metadata["suite"] == {"game": "Flak", "kind": kind}
+        assert metadata["observation_filters"] == "scaleoffset+gzip1"
+        assert json.loads(dataset.spec.env_spec.to_json())["kwargs"]["max_episode_steps"] == suite.EVAL_MAX_STEPS
+        if kind == "random":
+            assert metadata["policy"] is None and metadata["algorithm_name"] == "random"
+            continue
+        policy = metadata["policy"]
+        assert metadata["algorithm_name"] == f"PPO-{kind}"
+        assert policy["steps_trained"] == {"medium": 32768, "expert": 65536}[kind]
+        assert policy["eval_return"] == {"medium": 20.0, "expert": 40.0}[kind]
+        kept = result.path / policy["params_file"]
+        assert hashlib.sha256(kept.read_bytes()).hexdigest() == policy["params_sha256"]
+        assert jax_policy.describe(jax_policy.load_params(kept)) == ("actor_critic", 4, 4)
+    # the policies' actions are the network's samples, not the random ones
+    random_actions = np.concatenate([e.actions for e in minari.load_dataset("octax/Flak/random-v0").iterate_episodes()])
+    expert_actions = np.concatenate([e.actions for e in minari.load_dataset("octax/Flak/expert-v0").iterate_episodes()])
+    assert not np.array_equal(random_actions, expert_actions)
+
+
+def test_sampling_policy_draws_from_the_networks_softmax(tmp_path):
+    import jax
+
+    sys.path.insert(0, str(REPO / "examples"))
+    try:
+        import jax_networks
+    finally:
+        sys.path.remove(str(REPO / "examples"))
+    network = jax_networks.ActorCritic(3)
+    params = network.init(jax.random.key(1), np.zeros((1, 4, 32, 64), np.uint8))
+    # push the policy hard towards action 2 through the last layer's bias
+    params["params"]["Dense_1"]["bias"] = np.array([0.0, 0.0, 3.0], np.float32)  # p = e^3 / (e^3 + 2) = 0.91
+    path = tmp_path / "params.msgpack"
+    path.write_bytes(flax.serialization.to_bytes(params))
+    act = jax_policy.sampling_policy(jax_policy.load_params(path), seed=3)
+    obs = np.random.default_rng(0).integers(0, 2, (256, 4, 32, 64), dtype=np.uint8)
+    first, second = act(obs), act(obs)
+    assert first.shape == (256,) and first.dtype == np.int32
+    assert 0.85 < np.mean(first == 2) < 0.97 and not np.array_equal(first, second)  # sampled, and the key moves on
+    again = jax_policy.sampling_policy(jax_policy.load_params(path), seed=3)
+    assert np.array_equal(again(obs), first)  # the same seed, the same actions
