@@ -96,7 +96,7 @@ def test_make_train_and_evaluate_check_autoreset(counter_rom):
 def test_main_writes_csv_and_plot(tmp_path):
     summary = ppo.main(["--game", "Brix", "--num-envs", "4", "--num-steps", "8", "--num-minibatches", "2",
                         "--update-epochs", "1", "--total-steps", "64", "--eval-every", "32", "--eval-envs", "2",
-                        "--max-episode-steps", "40", "--out-dir", str(tmp_path)])
+                        "--max-episode-steps", "40", "--save-at-evals", "--out-dir", str(tmp_path)])
     with open(tmp_path / "progress.csv") as f:
         rows = list(csv.DictReader(f))
     assert tuple(rows[0]) == ppo.CSV_COLUMNS
@@ -108,6 +108,12 @@ def test_main_writes_csv_and_plot(tmp_path):
     assert float(rows[-1]["eval_ended_frac"]) == 1.0  # 40-step episodes end inside the 40-step cap
     assert (tmp_path / "learning_curve.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     assert summary["env_steps_per_s"] > 0
+    # --save-at-evals: the params at every evaluation (the dataset suite's medium policies), the last
+    # one the final params
+    checkpoints = sorted((tmp_path / "checkpoints").iterdir())
+    assert [p.name for p in checkpoints] == ["params-step0.msgpack", "params-step32.msgpack", "params-step64.msgpack"]
+    assert (tmp_path / "checkpoints" / "params-step64.msgpack").read_bytes() == (tmp_path / "params.msgpack").read_bytes()
+    assert checkpoints[0].read_bytes() != checkpoints[1].read_bytes()
 
 
 def test_ppo_learns_to_press_2(counter_rom, tmp_path):
