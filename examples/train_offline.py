@@ -158,6 +158,9 @@ def parse_args(argv: Optional[Sequence[str]] = None):
     parser.add_argument("--eval-envs", type=int, default=32, help="evaluation episodes per agent")
     parser.add_argument("--log-every", type=int, default=500, help="gradient steps per compiled chunk")
     parser.add_argument("--out-dir", type=Path, default=None, help="default runs/offline/<algorithm>-<kind>")
+    parser.add_argument("--summarize", nargs="+", type=Path, default=None, metavar="CSV",
+                        help="train nothing: the IQM summary of earlier runs' results.csv files (one game "
+                             "per file or several), written to --out-dir")
     args = parser.parse_args(argv)
     for name in ("steps", "batch_size", "num_seeds", "eval_envs", "log_every", "target_every"):
         if getattr(args, name) < 1:
@@ -167,17 +170,30 @@ def parse_args(argv: Optional[Sequence[str]] = None):
 
 def main(argv: Optional[Sequence[str]] = None) -> dict:
     args = parse_args(argv)
-    idents = args.dataset_id or [dataset_id(game, args.kind) for game in args.games]
     out_dir = args.out_dir or Path("runs/offline") / f"{args.algorithm}-{args.kind}"
     out_dir.mkdir(parents=True, exist_ok=True)
-    rows = [row for ident in idents for row in run_dataset(args.algorithm, ident, args)]
+    if args.summarize:
+        rows = []
+        for path in args.summarize:
+            with open(path, newline="") as file:
+                rows += [{**row, "normalized": float(row["normalized"])} for row in csv.DictReader(file)
+                         if row["algorithm"] == args.algorithm]
+        if not rows:
+            raise SystemExit(f"no {args.algorithm} rows in {', '.join(map(str, args.summarize))}")
+    else:
+        idents = args.dataset_id or [dataset_id(game, args.kind) for game in args.games]
+        rows = [row for ident in idents for row in run_dataset(args.algorithm, ident, args)]
     with open(out_dir / "results.csv", "w", newline="") as file:
         writer = csv.DictWriter(file, fieldnames=list(rows[0]))
         writer.writeheader()
         writer.writerows(rows)
     games = list(dict.fromkeys(row["game"] for row in rows))
-    matrix = np.array([[row["normalized"] for row in rows if row["game"] == game] for game in games]).T
-    summary = {"algorithm": args.algorithm, "datasets": idents, "command": sys.argv,
+    per_game = [[row["normalized"] for row in rows if row["game"] == game] for game in games]
+    if len({len(runs) for runs in per_game}) != 1:
+        raise SystemExit(f"every game needs the same number of seeds to aggregate, got {dict(zip(games, map(len, per_game)))}")
+    matrix = np.array(per_game).T
+    summary = {"algorithm": args.algorithm, "datasets": list(dict.fromkeys(row["dataset_id"] for row in rows)),
+               "command": sys.argv,
                "normalized": {game: matrix[:, j].tolist() for j, game in enumerate(games)},
                **{name: dataclasses.asdict(interval) for name, interval in scores.aggregate(matrix).items()}}
     (out_dir / "summary.json").write_text(json.dumps(summary, indent=2, default=float) + "\n")

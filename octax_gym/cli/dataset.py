@@ -93,16 +93,18 @@ def _cmd_collect(args: argparse.Namespace) -> int:
 
 
 def _cmd_suite(args: argparse.Namespace) -> int:
-    from octax_gym.datasets.suite import build_suite
+    from octax_gym.datasets.suite import EVAL_MAX_STEPS, build_suite
 
     with _datasets_path(args.data_path):
         results = build_suite(args.runs, args.games, args.kinds, steps=args.steps, num_envs=args.envs,
                               seed=args.seed, overwrite=args.overwrite, progress=not args.no_progress)
     for result in results:
-        returns = [float(sum(e.rewards)) for e in result.dataset.iterate_episodes()]
-        print(f"wrote {result.dataset_id}: {result.episodes} episodes, {result.steps} steps, mean return "
-              f"{sum(returns) / len(returns):.2f}, {_megabytes(result.path):,.1f} MB "
-              f"({result.steps_per_second:,.0f} steps/s)")
+        # the episodes the env ended (terminated, or at the cap), not those cut by the end of collection
+        whole = [float(e.rewards.sum()) for e in result.dataset.iterate_episodes()
+                 if e.terminations[-1] or e.infos["episode_step"][-1] >= EVAL_MAX_STEPS]
+        mean = f"{sum(whole) / len(whole):.2f}" if whole else "n/a"
+        print(f"wrote {result.dataset_id}: {result.episodes} episodes ({len(whole)} whole: mean return {mean}), "
+              f"{result.steps} steps, {_megabytes(result.path):,.1f} MB ({result.steps_per_second:,.0f} steps/s)")
     return 0
 
 

@@ -96,3 +96,20 @@ def test_progress_bar_shows_unless_no_progress(tmp_path, capsys):
                      "--steps", "6"]) == 0
     assert "collecting octax/Brix-v0" in capsys.readouterr().err
     assert minari.load_dataset("octax/Brix-bar-v0").total_steps == 6
+
+
+def test_suite_collects_random_datasets_and_names_a_missing_training_run(tmp_path, capsys):
+    data = tmp_path / "data"
+    assert cli.main(["dataset", "suite", "--runs", str(tmp_path / "runs"), "--games", "Flak", "--kinds", "random",
+                     "--steps", "40", "--envs", "4", "--no-progress", "--data-path", str(data)]) == 0
+    line = capsys.readouterr().out.strip().splitlines()[-1]
+    assert re.match(r"wrote octax/Flak/random-v0: \d+ episodes \(\d+ whole: mean return (\S+)\), 40 steps, ", line), line
+    assert (data / "octax" / "Flak" / "random-v0" / "data" / "main_data.hdf5").is_file()
+    # medium and expert need the game's training run: the error names the command that makes it
+    assert cli.main(["dataset", "suite", "--runs", str(tmp_path / "runs"), "--games", "Flak", "--kinds", "expert",
+                     "--steps", "40", "--no-progress", "--data-path", str(data)]) == 1
+    assert "examples/train_jax_ppo.py --save-at-evals" in capsys.readouterr().err
+    with pytest.raises(SystemExit):
+        cli.main(["dataset", "suite", "--games", "Flak"])  # --runs is required
+    assert cli.main(["dataset", "suite", "--runs", str(tmp_path), "--games", "Pong", "--no-progress"]) == 1
+    assert "Airplane" in capsys.readouterr().err  # the suite's games listed
