@@ -70,7 +70,8 @@ def add_commands(commands: argparse._SubParsersAction) -> None:
                        help="a subset of random medium expert (default: all three)")
     build.add_argument("--steps", type=int, default=suite.STEPS, metavar="N",
                        help=f"steps per dataset (default {suite.STEPS:,})")
-    build.add_argument("--envs", type=int, default=suite.ENVS, metavar="K", help=f"lanes (default {suite.ENVS})")
+    build.add_argument("--envs", type=int, default=suite.ENVS, metavar="K",
+                       help=f"lanes (default {suite.ENVS}: long episodes end inside the dataset)")
     build.add_argument("--seed", type=int, default=0, metavar="S", help="the first episode seed and the policies' seed")
     build.add_argument("--data-path", type=Path, metavar="DIR",
                        help=f"write under DIR instead of ${DATASETS_PATH_VARIABLE} (default ~/.minari/datasets)")
