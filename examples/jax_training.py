@@ -32,6 +32,7 @@ from tqdm import tqdm
 import octax_core
 from octax_gym.scores import iqm
 
+LOOP_FIELDS = ("save_at_evals", "checkpoint_every")  # what `train`'s loop does, flags of `main` only
 COMMON_COLUMNS = ("seed", "step", "update", "wall_s", "env_steps_per_s", "eval_mean_return", "eval_std",
                   "eval_ended_frac", "random_mean_return", "train_episode_return", "train_episodes")
 
@@ -57,6 +58,7 @@ class RunConfig:
     eval_envs: int = 128  # one episode each (the paper's 128 parallel envs)
     eval_max_steps: Optional[int] = None  # step cap per eval; None: the env's max_episode_steps
     save_at_evals: bool = False  # also write the params at every evaluation (checkpoints/params-step<N>...)
+    checkpoint_every: int = 0  # updates between resumable checkpoints (resume/checkpoint.msgpack); 0: none
     env_overrides: tuple[tuple[str, Any], ...] = ()  # octax_core.make overrides, e.g. max_episode_steps
 
     @property
@@ -85,6 +87,8 @@ class RunConfig:
                              f"num_minibatches = {self.num_minibatches}")
         if self.num_seeds < 1:
             raise ValueError(f"num_seeds must be at least 1, got {self.num_seeds}")
+        if self.checkpoint_every < 0:
+            raise ValueError(f"checkpoint_every must be >= 0 (0: no checkpoints), got {self.checkpoint_every}")
 
 
 class Trainer(NamedTuple):
@@ -210,7 +214,8 @@ def seed_keys(config: RunConfig) -> tuple[jax.Array, jax.Array, jax.Array]:
 
 # --- the run ----------------------------------------------------------------------------------
 
-def train(config: RunConfig, make_train: Callable, out_dir, game=None, rom=None, progress: bool = True) -> dict:
+def train(config: RunConfig, make_train: Callable, out_dir, game=None, rom=None, progress: bool = True,
+          resume: bool = False) -> dict:
     """Trains `config.num_seeds` agents of `make_train(config, env, env_params) -> Trainer` at once,
     evaluating as configured; writes config.json (the algorithm, the env and every setting),
     progress.csv, learning_curve.png and the params to `out_dir`.
@@ -218,10 +223,15 @@ def train(config: RunConfig, make_train: Callable, out_dir, game=None, rom=None,
     `game` (an id or a `GameSpec`) and `rom` default to `config.game` and the ROM store. Returns a
     summary: paths, training speed (env steps/s over all seeds, compile and evaluation excluded),
     the random baseline and the last evaluation (means over seeds, and per seed).
+
+    `resume`: continue the run in `out_dir` from its last checkpoint (`config.checkpoint_every`):
+    the runner, the update count, the metric sums since the last evaluation and the log's rows up
+    to that update come back, and the rest of the run is the one an uninterrupted run does.
     """
     config.check()
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
+    checkpoints = Checkpoints(out_dir / "resume")
     env, eval_env, env_params = make_envs(config, game, rom)
     trainer = make_train(config, env, env_params)
     seeds = config.num_seeds
@@ -232,11 +242,16 @@ def train(config: RunConfig, make_train: Callable, out_dir, game=None, rom=None,
         make_evaluate(eval_env, env_params, config.eval_envs, eval_steps, random_act(env.num_actions), jit=False),
         seeds, in_axes=(None, 0)))
 
-    (out_dir / "config.json").write_text(json.dumps(
-        {"algorithm": trainer.name, "env_id": env.spec.id, "command": sys.argv,
-         **dataclasses.asdict(config)}, indent=2, default=str) + "\n")
+    if not resume:
+        (out_dir / "config.json").write_text(json.dumps(
+            {"algorithm": trainer.name, "env_id": env.spec.id, "command": sys.argv,
+             **dataclasses.asdict(config)}, indent=2, default=str) + "\n")
     train_keys, eval_keys, random_keys = seed_keys(config)
     runner = init_seeds(trainer.init, train_keys)
+    start_at = None
+    if resume:
+        runner, start_at = checkpoints.load(runner)
+        print(f"resuming {out_dir} at update {start_at['update']} of {config.num_updates}")
     compile_start = time.perf_counter()
     # Compiled ahead of time, so every timed call below runs and none compiles.
     update = jax.jit(over_seeds(trainer.update, seeds), donate_argnums=0).lower(runner).compile()
@@ -250,7 +265,8 @@ def train(config: RunConfig, make_train: Callable, out_dir, game=None, rom=None,
 
     title = f"{trainer.name} on {env.spec.id} ({config.num_envs} envs x {config.num_steps} steps" + (
         f", {seeds} seeds)" if seeds > 1 else ")")
-    log = RunLog(out_dir, config.seeds, random_means, title, trainer.metric_names)
+    log = RunLog(out_dir, config.seeds, random_means, title, trainer.metric_names,
+                 keep_until=None if start_at is None else start_at["update"])
     start = time.perf_counter()
     bar = tqdm(total=config.num_updates * config.batch_size * seeds, unit="step", unit_scale=True,
                disable=not progress, desc=f"{trainer.name} {env.spec.id}" + (f" x{seeds}" if seeds > 1 else ""))
@@ -267,8 +283,11 @@ def train(config: RunConfig, make_train: Callable, out_dir, game=None, rom=None,
     if config.save_at_evals:
         (out_dir / "checkpoints").mkdir(exist_ok=True)
         checkpoint = lambda step, params: save_params(params, out_dir / "checkpoints", f"params-step{step}")  # noqa: E731
+    if start_at is not None:
+        bar.update(start_at["update"] * config.batch_size * seeds)
+    save = checkpoints.save if config.checkpoint_every else None
     runner, train_s, rows = _loop(config, trainer, update, runner, evaluate_policy, eval_keys, log, bar, start,
-                                  checkpoint)
+                                  checkpoint, save, start_at)
     bar.close()
     params = trainer.params(runner)
     param_paths = save_params(params, out_dir, "params")
@@ -287,9 +306,12 @@ def train(config: RunConfig, make_train: Callable, out_dir, game=None, rom=None,
 
 
 def _loop(config: RunConfig, trainer: Trainer, update, runner, evaluate_policy, eval_keys, log: "RunLog",
-          bar, start: float, checkpoint: Optional[Callable] = None):
+          bar, start: float, checkpoint: Optional[Callable] = None, save: Optional[Callable] = None,
+          start_at: Optional[dict] = None):
     """The updates, with an evaluation of every seed every `eval_every` steps and at both ends
-    (and `checkpoint(step, params)` after each, when given).
+    (and `checkpoint(step, params)` after each, when given). With `save`, every
+    `checkpoint_every` updates `save(runner, position)` writes a resumable checkpoint; `start_at`
+    (a loaded one's position) starts the loop where it was written.
 
     Returns the runner, the seconds spent in updates, and the last evaluation's rows (one per seed).
     """
@@ -297,9 +319,12 @@ def _loop(config: RunConfig, trainer: Trainer, update, runner, evaluate_policy, 
     if config.eval_every:
         eval_interval = max(1, round(config.eval_every / config.batch_size))
     fold = jax.jit(jax.vmap(jax.random.fold_in, in_axes=(0, None)))
-    train_s, totals = 0.0, {}
-    for i in range(config.num_updates + 1):
-        if i % eval_interval == 0 or i == config.num_updates:
+    train_s, totals, first, rows = 0.0, {}, 0, log.rows[-len(config.seeds):]
+    if start_at is not None:
+        first, train_s, totals = start_at["update"], start_at["train_s"], start_at["totals"]
+    for i in range(first, config.num_updates + 1):
+        resumed_here = start_at is not None and i == first  # its evaluation and checkpoint are on disk
+        if (i % eval_interval == 0 or i == config.num_updates) and not resumed_here:
             returns, ended = jax.device_get(evaluate_policy(trainer.params(runner), fold(eval_keys, i)))
             rows = log.add(i, i * config.batch_size, time.perf_counter() - start, train_s, returns, ended,
                            totals, trainer.host_metrics(i))
@@ -309,6 +334,8 @@ def _loop(config: RunConfig, trainer: Trainer, update, runner, evaluate_policy, 
             totals = {}
         if i == config.num_updates:
             return runner, train_s, rows
+        if save is not None and i % config.checkpoint_every == 0 and i > 0 and not resumed_here:
+            save(runner, {"update": i, "train_s": train_s, "totals": totals})
         t0 = time.perf_counter()
         runner, metrics = update(runner)
         metrics = jax.device_get(metrics)  # waits for the update: the timing covers all of it
@@ -319,17 +346,83 @@ def _loop(config: RunConfig, trainer: Trainer, update, runner, evaluate_policy, 
         bar.update(config.batch_size * config.num_seeds)
 
 
+class Checkpoints:
+    """A run's resumable checkpoint: `<out_dir>/resume/checkpoint.msgpack` (flax serialization of
+    every seed's runner, typed PRNG keys as their raw data, and the loop's position: updates done,
+    training seconds, the metric sums since the last evaluation) and `checkpoint.json` (the
+    position, readable). Each is written to a temporary file and renamed over the last one, so a
+    kill at any moment leaves the previous checkpoint or the new one whole, never a torn file."""
+
+    def __init__(self, folder: Path):
+        self.folder = folder
+        self.path, self.info_path = folder / "checkpoint.msgpack", folder / "checkpoint.json"
+
+    def save(self, runner, position: dict) -> None:
+        self.folder.mkdir(parents=True, exist_ok=True)
+        leaves = jax.device_get(jax.tree.leaves(_keys_as_data(runner)))
+        payload = {"runner": {str(i): np.asarray(leaf) for i, leaf in enumerate(leaves)},
+                   "update": position["update"], "train_s": position["train_s"],
+                   "totals": {k: np.asarray(v, np.float64) for k, v in position["totals"].items()}}
+        _replace(self.path, flax.serialization.msgpack_serialize(payload))
+        _replace(self.info_path, (json.dumps({"update": position["update"]}) + "\n").encode())
+
+    def load(self, template):
+        """The runner (shaped as `template`, a freshly initialised one) and the position."""
+        if not self.path.is_file():
+            raise FileNotFoundError(f"no checkpoint to resume from at {self.path} (was the run started with "
+                                    "--checkpoint-every N, and had it written one?)")
+        state = flax.serialization.msgpack_restore(self.path.read_bytes())
+        expected, treedef = jax.tree.flatten(_keys_as_data(template))
+        leaves = [state["runner"][str(i)] for i in range(len(state["runner"]))]
+        if [(np.shape(a), np.asarray(a).dtype) for a in leaves] != [(a.shape, a.dtype) for a in expected]:
+            raise ValueError(f"{self.path} holds a runner of another shape (another config or algorithm)")
+        runner = jax.tree.map(lambda t, x: jax.random.wrap_key_data(x, impl=jax.random.key_impl(t))
+                              if _is_key(t) else jnp.asarray(x), template, treedef.unflatten(leaves))
+        totals = {k: (int(v) if k == "updates" else np.asarray(v, np.float64)) for k, v in state["totals"].items()}
+        return runner, {"update": int(state["update"]), "train_s": float(state["train_s"]), "totals": totals}
+
+
+def _is_key(x) -> bool:
+    return isinstance(x, jax.Array) and jnp.issubdtype(x.dtype, jax.dtypes.prng_key)
+
+
+def _keys_as_data(tree):
+    return jax.tree.map(lambda x: jax.random.key_data(x) if _is_key(x) else x, tree)
+
+
+def _replace(path: Path, data: bytes) -> None:
+    temporary = path.with_suffix(path.suffix + ".tmp")
+    temporary.write_bytes(data)
+    temporary.replace(path)
+
+
+def _number(text: str):
+    """A CSV cell back as the int or float it was written from."""
+    try:
+        return int(text)
+    except ValueError:
+        return float(text)
+
+
 class RunLog:
     """Appends one CSV row per seed and evaluation, and redraws the learning curve."""
 
-    def __init__(self, out_dir: Path, seeds: Sequence[int], random_means, title: str, metric_names: Sequence[str]):
+    def __init__(self, out_dir: Path, seeds: Sequence[int], random_means, title: str, metric_names: Sequence[str],
+                 keep_until: Optional[int] = None):
+        """A new log; or, with `keep_until` (a resumed run's update), the existing progress.csv's rows
+        up to that update, rewritten without the rows a killed run logged after its checkpoint."""
         self.csv_path, self.png_path = out_dir / "progress.csv", out_dir / "learning_curve.png"
         self.seeds, self.random_means = list(seeds), np.asarray(random_means, np.float64)
         self.title, self.metric_names, self.rows = title, tuple(metric_names), []
         self.columns = COMMON_COLUMNS + self.metric_names
         self._extra_columns: Optional[tuple[str, ...]] = None
+        if keep_until is not None:
+            with open(self.csv_path, newline="") as f:
+                self.rows = [{k: _number(v) for k, v in row.items()} for row in csv.DictReader(f)
+                             if int(row["update"]) <= keep_until]
         with open(self.csv_path, "w", newline="") as f:
             csv.writer(f).writerow(self.columns)
+            csv.DictWriter(f, self.columns).writerows(self.rows)
 
     def add(self, update, step, wall_s, train_s, returns, ended, totals, host_metrics) -> list[dict]:
         """Rows for one evaluation: `returns` and `ended` are (num_seeds, eval_envs); `totals` holds
@@ -403,6 +496,9 @@ HELP = {
     "eval_every": "env steps between evaluations; 0: only at the start and the end",
     "eval_envs": "evaluation episodes (one per env) per seed, played to their end",
     "eval_max_steps": "step cap per evaluation; None: the env's max_episode_steps",
+    "checkpoint_every": "write a resumable checkpoint (every seed's runner: params, optimizer and env state, "
+                        "keys; the log so far) every N updates to <out-dir>/resume/; 0: none. --resume "
+                        "<out-dir> continues a killed run to the params an uninterrupted one ends with",
     "save_at_evals": "also write the params at every evaluation, as checkpoints/params-step<N>[-seed<S>].msgpack "
                      "(the dataset suite's medium policies come from these)",
 }
@@ -411,14 +507,19 @@ ENV_FLAGS = {"max_episode_steps": int, "frames_per_step": int, "repeat_action_pr
 
 
 def parse_args(config_type: type, help_text: dict, description: str, runs_dir: str,
-               argv: Optional[Sequence[str]] = None) -> tuple[Any, Path]:
+               argv: Optional[Sequence[str]] = None, loop_flags: bool = False):
     """A `config_type` (a `RunConfig` dataclass) and the output folder from the command line:
-    one flag per field, plus the env overrides of ENV_FLAGS and `--out-dir`."""
+    one flag per field, plus the env overrides of ENV_FLAGS and `--out-dir`.
+
+    `loop_flags`: also offer what `train`'s loop does (`--save-at-evals`, `--checkpoint-every`,
+    `--resume DIR`) and return (config, out_dir, resume); examples with loops of their own leave
+    them out, so no flag does nothing. With `--resume DIR` the config is DIR's config.json.
+    """
     parser = argparse.ArgumentParser(description=description,
                                      formatter_class=argparse.ArgumentDefaultsHelpFormatter)
     helps = {**HELP, **help_text}
     for field in dataclasses.fields(config_type):
-        if field.name == "env_overrides":
+        if field.name == "env_overrides" or (field.name in LOOP_FIELDS and not loop_flags):
             continue
         flag = "--" + field.name.replace("_", "-")
         if field.type in ("bool", bool):
@@ -434,7 +535,14 @@ def parse_args(config_type: type, help_text: dict, description: str, runs_dir: s
     parser.add_argument("--out-dir", type=Path, default=None,
                         help="for progress.csv, learning_curve.png and the params; "
                              f"None: {runs_dir}/<game>-s<seed>[-n<num_seeds>]")
+    if loop_flags:
+        parser.add_argument("--resume", type=Path, default=None, metavar="DIR",
+                            help="continue the run in DIR (made with --checkpoint-every) from its last checkpoint, "
+                                 "with DIR's config.json; other flags are ignored")
     args = vars(parser.parse_args(argv))
+    resume = args.pop("resume", None)
+    if resume is not None:
+        return load_config(config_type, resume / "config.json"), resume, True
     out_dir = args.pop("out_dir")
     overrides = tuple((k, args.pop(k)) for k in ENV_FLAGS if args[k] is not None)
     for k in ENV_FLAGS:
@@ -442,7 +550,21 @@ def parse_args(config_type: type, help_text: dict, description: str, runs_dir: s
     config = config_type(**args, env_overrides=overrides)
     config.check()
     name = f"{config.game}-s{config.seed}" + (f"-n{config.num_seeds}" if config.num_seeds > 1 else "")
-    return config, out_dir or Path(runs_dir) / name
+    out_dir = out_dir or Path(runs_dir) / name
+    return (config, out_dir, False) if loop_flags else (config, out_dir)
+
+
+def load_config(config_type: type, path: Path):
+    """The config a run wrote to its config.json (`train`), as a `config_type`."""
+    if not path.is_file():
+        raise SystemExit(f"--resume: no {path.name} in {path.parent} (not a run folder of this example)")
+    saved = json.loads(path.read_text())
+    fields = {field.name for field in dataclasses.fields(config_type)}
+    values = {k: v for k, v in saved.items() if k in fields}
+    values["env_overrides"] = tuple(tuple(pair) for pair in values.get("env_overrides", ()))
+    config = config_type(**values)
+    config.check()
+    return config
 
 
 def main(name: str, config_type: type, make_train: Callable, help_text: dict, doc: str, runs_dir: str,
@@ -450,8 +572,9 @@ def main(name: str, config_type: type, make_train: Callable, help_text: dict, do
     """An example's command line: parses `argv` into a `config_type` (flags described by
     `help_text` and the first paragraph of the example's `doc`), trains `make_train`'s algorithm
     `name` with `train` and returns its summary."""
-    config, out_dir = parse_args(config_type, help_text, doc.split("\n\n")[0], runs_dir, argv)
+    config, out_dir, resume = parse_args(config_type, help_text, doc.split("\n\n")[0], runs_dir, argv,
+                                         loop_flags=True)
     print(f"{name} on {config.game}: {config}")
-    summary = train(config, make_train, out_dir)
+    summary = train(config, make_train, out_dir, resume=resume)
     print(f"wrote {summary['csv']} and {summary['png']}")
     return summary
