@@ -86,8 +86,8 @@ def pick_policies(run_dir) -> dict[str, PolicyCard]:
         raise FileNotFoundError(f"no suite training run in {run_dir} (missing: {', '.join(missing) or 'checkpoints/'}); "
                                 "train it with examples/train_jax_ppo.py --save-at-evals (docs/datasets.md)")
     config = json.loads((run_dir / "config.json").read_text())
-    with open(run_dir / "progress.csv", newline="") as file:
-        rows = [row for row in csv.DictReader(file)]
+    with open(run_dir / "progress.csv", newline="") as file:  # a one-seed run's rows (params.msgpack is its)
+        rows = [row for row in csv.DictReader(file) if int(row["seed"]) == int(config.get("seed", 0))]
     evals = {int(row["step"]): float(row["eval_mean_return"]) for row in rows}
     random_return = float(rows[0]["random_mean_return"])
     final_step = max(evals)
