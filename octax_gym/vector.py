@@ -25,7 +25,7 @@ import numpy as np
 from gymnasium import spaces
 from gymnasium.vector import AutoresetMode
 
-from octax_gym import action_check, backends, compiled_step, opponent as opponents, render
+from octax_gym import action_check, backends, compiled_step, opponent as opponents, render, sharding
 from octax_core.emulator.state import screen_values, shown
 from octax_core.env.config import check_option_names
 from octax_core.validate import check_int
@@ -117,7 +117,7 @@ class OctaxVectorEnv(gymnasium.vector.VectorEnv):
                  backend: str = "numpy", device: Any = None, render_mode: Optional[str] = None,
                  render_scale: int = render.DEFAULT_RENDER_SCALE, palette: Optional[render.PaletteArg] = None,
                  rom=None, opponent: Any = None, seat: int = 0, games: Any = None, weights: Any = None,
-                 **env_options):
+                 devices: Any = None, **env_options):
         check_option_names(env_options, KEYWORDS, type(self).__name__)
         if games is not None:  # "octax/Mix-v0" with games=[...]
             game = games if isinstance(games, str) else tuple(games)
@@ -125,15 +125,25 @@ class OctaxVectorEnv(gymnasium.vector.VectorEnv):
             raise ValueError("weights= is for a mix of games (games=[...]); one game has no weights")
         self._weights = weights
         self._setup(game, num_envs, autoreset_mode, backend, device, render_mode, render_scale, palette, rom,
-                    env_options, opponent=opponent, seat=seat)
+                    env_options, opponent=opponent, seat=seat, devices=devices)
 
     def _setup(self, game, num_envs, autoreset_mode, backend, device, render_mode, render_scale, palette, rom,
-               env_options, *, players: int = 1, opponent: Any = None, seat: int = 0):
+               env_options, *, players: int = 1, opponent: Any = None, seat: int = 0, devices: Any = None):
         """The construction `MultiAgentVectorEnv` shares: arguments checked, compiled step built."""
-        self.num_envs = check_int("num_envs", num_envs)
+        self.num_envs = self.global_num_envs = check_int("num_envs", num_envs)
         self.autoreset_mode = check_autoreset_mode(autoreset_mode)
         self.backend = backends.check_backend(backend)
-        self.device = backends.resolve_device(device)
+        self._shards = None
+        if devices is None:
+            self.device = backends.resolve_device(device)
+        else:
+            if device is not None:
+                raise ValueError("give device= (one device) or devices= (the batch sharded over several), not both")
+            if opponent is not None or players != 1:
+                raise ValueError("devices= shards one-player envs; a two-player env or an opponent= runs on one device")
+            self._shards = sharding.Shards(devices, self.num_envs)
+            self.device, self.num_envs = self._shards.device, self._shards.num_local
+        self.global_env_ids = np.arange(self.num_envs) if self._shards is None else self._shards.global_env_ids
         self.render_mode = check_choice("render_mode", render_mode, RENDER_MODES)
         self.render_scale = render.check_render_scale(render_scale)
         if palette is not None:
@@ -158,10 +168,13 @@ class OctaxVectorEnv(gymnasium.vector.VectorEnv):
         self.agents = getattr(self.core_env, "agents", None)  # the seats' names in a two-player env
         if palette is None:
             self.palette = render.resolve_palette(self.game_spec.palette or render.DEFAULT_PALETTE)
-        self.params = jax.device_put(params, self.device)
-        self._step_fn = self._compiled.step[self.autoreset_mode]
-        self._action_check = action_check.DeferredCheck(self.game_name, self.core_env.num_actions, self.device,
-                                                        self.agents)
+        self.params = jax.device_put(params, self.device) if self._shards is None else self._shards.replicate(params)
+        self._step_fn, self._reset_fn = self._compiled.step[self.autoreset_mode], self._compiled.reset
+        if self._shards is not None:
+            self._step_fn, self._reset_fn = map(self._shards.partitioned, (self._step_fn, self._reset_fn))
+        self._action_check = action_check.DeferredCheck(
+            self.game_name, self.core_env.num_actions, self.device if self._shards is None else self._shards.replicated,
+            self.agents)
 
         config = self.core_env.config
         self.metadata = {**type(self).metadata, "autoreset_mode": self.autoreset_mode,
@@ -177,8 +190,9 @@ class OctaxVectorEnv(gymnasium.vector.VectorEnv):
 
     def reset(self, *, seed: Optional[Union[int, list[int]]] = None, options: Optional[dict] = None):
         """Resets every env, or with `options={"reset_mask": m}` (bool numpy array (num_envs,))
-        only the rows where m is True. An int seed s seeds env i with s + i."""
-        seeds = None if seed is None else seeds_for(seed, self.num_envs)  # checks the seed first
+        only the rows where m is True. An int seed s seeds env i with s + i (with `devices=`, global
+        env i: `global_env_ids[j]` for this process's row j; a list of seeds is the global batch's)."""
+        seeds = None if seed is None else seeds_for(seed, self.global_num_envs)  # checks the seed first
         self._action_check.poll()  # earlier steps' device actions whose check has finished
         super().reset(seed=int(seed) if isinstance(seed, (int, np.integer)) else None)
         options = dict(options or {})
@@ -188,19 +202,22 @@ class OctaxVectorEnv(gymnasium.vector.VectorEnv):
             mask = self._check_mask(mask)
         if self._state is None or seeds is not None:
             if seeds is None:  # the first reset without a seed: draw one
-                seeds = seeds_for(int(self.np_random.integers(0, 2**31 - self.num_envs)), self.num_envs)
-            keys = jax.device_put(keys_from_seeds(seeds), self.device)
+                seeds = seeds_for(int(self.np_random.integers(0, 2**31 - self.global_num_envs)), self.global_num_envs)
+            if self._shards is None:
+                keys = jax.device_put(keys_from_seeds(seeds), self.device)
+            else:
+                keys = self._shards.keys([seeds[i] for i in self.global_env_ids])
             if self._keys is None or mask is None:
                 self._keys = keys
             else:
-                self._keys = compiled_step.select_keys(jax.numpy.asarray(mask), keys, self._keys)
+                self._keys = compiled_step.select_keys(self._batch(mask), keys, self._keys)
         if self._state is None or mask is None:
-            self._keys, self._obs, self._state, info = self._compiled.reset(self._keys, None, None, None, self.params)
+            self._keys, self._obs, self._state, info = self._reset_fn(self._keys, None, None, None, self.params)
         else:
-            self._keys, self._obs, self._state, info = self._compiled.reset(
-                self._keys, self._state, self._obs, jax.device_put(mask, self.device), self.params)
-        self._info = info
-        return backends.to_backend(self._obs, self.backend), backends.to_backend(info, self.backend)
+            self._keys, self._obs, self._state, info = self._reset_fn(
+                self._keys, self._state, self._obs, self._batch(mask), self.params)
+        self._info = info = self._local(info)
+        return backends.to_backend(self._local(self._obs), self.backend), backends.to_backend(info, self.backend)
 
     def step(self, actions):
         """Steps every env with its action; one jitted call, no host sync inside it.
@@ -219,8 +236,9 @@ class OctaxVectorEnv(gymnasium.vector.VectorEnv):
         self._keys, self._obs, self._state, reward, terminated, truncated, info, report = self._step_fn(
             self._keys, self._state, actions, self._action_check.report, self.params, *extra)
         self._action_check.record(report, unchecked)
+        obs, reward, terminated, truncated, info = self._local((self._obs, reward, terminated, truncated, info))
         self._info = info
-        out = backends.to_backend((self._obs, reward, terminated, truncated, info), self.backend)
+        out = backends.to_backend((obs, reward, terminated, truncated, info), self.backend)
         if self.backend == "numpy":  # the outputs were just read back, so the report is ready too
             self._action_check.poll(wait=True)
         return out
@@ -233,7 +251,7 @@ class OctaxVectorEnv(gymnasium.vector.VectorEnv):
             return None
         if self._state is None:
             raise gymnasium.error.ResetNeeded("call reset() before render()")
-        pixels = screen_values(np.asarray(shown(self._state.machine)), self.core_env.machine.platform)
+        pixels = screen_values(np.asarray(shown(self._local(self._state).machine)), self.core_env.machine.platform)
         return tuple(render.to_rgb(p, self.render_scale, self.palette) for p in pixels)
 
     def close_extras(self, **kwargs):
@@ -242,9 +260,23 @@ class OctaxVectorEnv(gymnasium.vector.VectorEnv):
 
     # --- helpers ----------------------------------------------------------------------------
 
+    def _batch(self, rows: np.ndarray) -> jax.Array:
+        """This process's rows of a batched host array where the step reads it: on the device, or
+        with `devices=` into the global batch."""
+        return jax.device_put(rows, self.device) if self._shards is None else self._shards.to_global(rows)
+
+    def _local(self, tree):
+        """The step's outputs as this process's rows (with `devices=`; as they are otherwise)."""
+        return tree if self._shards is None else self._shards.to_local(tree)
+
     def _actions_to_device(self, actions) -> tuple[jax.Array, bool]:
         """The step's actions checked (`octax_gym.action_check`) and on the device; against an
-        opponent, host actions are checked against the learner's `action_mask` too."""
+        opponent, host actions are checked against the learner's `action_mask` too. With
+        `devices=` they are read to the host, checked there, and placed into the global batch."""
+        if self._shards is not None:
+            host = action_check.check_batch(action_check.to_host(actions), self.num_envs,
+                                            self.single_action_space.n, self.game_name)
+            return self._shards.to_global(host.astype(np.int32)), False
         actions, unchecked = action_check.to_device(actions, self.num_envs, self.single_action_space.n,
                                                     self.device, self.game_name)
         if self.view is not None and self.core_env.turn_based and not unchecked:
