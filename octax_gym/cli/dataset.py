@@ -49,9 +49,23 @@ def add_commands(commands: argparse._SubParsersAction) -> None:
     collect.add_argument("--data-path", type=Path, metavar="DIR",
                          help=f"write under DIR instead of ${DATASETS_PATH_VARIABLE} (default ~/.minari/datasets); "
                               f"load it with {DATASETS_PATH_VARIABLE}=DIR")
+    collect.add_argument("--shard", type=int, metavar="R", help="collect shard R of --num-shards P: its share of the "
+                         "steps, its own seeds, written as ID with -shardR before the version")
+    collect.add_argument("--num-shards", type=int, metavar="P", help="shards in all (with --shard)")
     collect.add_argument("--overwrite", action="store_true", help="replace a dataset of that id")
     collect.add_argument("--no-progress", action="store_true", help="no progress bar")
     collect.set_defaults(func=_cmd_collect)
+
+    combine = sub.add_parser("combine", help="write the episodes of several shards as one dataset",
+                             description="Writes the episodes of the shard datasets, in order, with their seeds, "
+                                         "into one compact Minari dataset (the shards must come from the same env; "
+                                         "no seed in two shards). See docs/datasets.md.")
+    combine.add_argument("shards", nargs="+", metavar="SHARD_ID", help="the shard datasets' ids")
+    combine.add_argument("--dataset-id", required=True, metavar="ID", help="the combined dataset's id")
+    combine.add_argument("--data-path", type=Path, metavar="DIR", help=f"read and write under DIR instead of "
+                                                                       f"${DATASETS_PATH_VARIABLE}")
+    combine.add_argument("--overwrite", action="store_true", help="replace a dataset of that id")
+    combine.set_defaults(func=_cmd_combine)
 
     from octax_gym.datasets import suite  # no JAX or Minari: names and defaults only
 
@@ -84,12 +98,31 @@ def _cmd_collect(args: argparse.Namespace) -> int:
     from octax_gym.datasets import collect_dataset
 
     env_options = {} if args.max_episode_steps is None else {"max_episode_steps": args.max_episode_steps}
+    dataset_id, steps, seed = args.dataset_id, args.steps, args.seed
+    if (args.shard is None) != (args.num_shards is None):
+        raise ValueError("--shard R and --num-shards P go together")
+    if args.shard is not None:
+        from octax_gym.datasets.combine import shard_dataset_id, shard_plan
+
+        steps, seed = shard_plan(args.steps, args.envs, args.seed, args.shard, args.num_shards)
+        dataset_id = shard_dataset_id(args.dataset_id, args.shard)
     with _datasets_path(args.data_path):
-        result = collect_dataset(args.game, args.dataset_id, args.steps, num_envs=args.envs, policy=args.policy,
-                                 seed=args.seed, overwrite=args.overwrite, progress=not args.no_progress,
+        result = collect_dataset(args.game, dataset_id, steps, num_envs=args.envs, policy=args.policy,
+                                 seed=seed, overwrite=args.overwrite, progress=not args.no_progress,
                                  **env_options)
     print(f"wrote {result.dataset_id}: {result.episodes} episodes, {result.steps} steps in {result.seconds:.1f} s "
           f"({result.steps_per_second:,.0f} steps/s), {_megabytes(result.path):,.1f} MB at {result.path}")
+    return 0
+
+
+def _cmd_combine(args: argparse.Namespace) -> int:
+    from octax_gym.datasets.combine import combine_datasets
+
+    with _datasets_path(args.data_path):
+        dataset = combine_datasets(args.shards, args.dataset_id, overwrite=args.overwrite)
+        path = Path(dataset.storage.data_path).parent
+    print(f"wrote {args.dataset_id}: {dataset.total_episodes} episodes, {dataset.total_steps} steps from "
+          f"{len(args.shards)} shards, {_megabytes(path):,.1f} MB at {path}")
     return 0
 
 

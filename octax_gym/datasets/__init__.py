@@ -25,6 +25,7 @@ _EXPORTS = {
     "DatasetWriter": "storage", "EpisodeRecord": "storage", "INSTALL_HINT": "storage",
     "Batch": "transitions", "Transitions": "transitions", "load_transitions": "transitions",
     "build_suite": "suite", "pick_policies": "suite",
+    "combine_datasets": "combine", "shard_plan": "combine",
 }
 __all__ = sorted(_EXPORTS)
 

@@ -60,6 +60,16 @@ class EpisodeRecord:
         for name, value in info.items():
             self.infos[name].append(value)
 
+    @classmethod
+    def from_stored(cls, seed: int, episode: dict) -> "EpisodeRecord":
+        """An episode as Minari's storage reader gives it (`get_episodes`), to write again."""
+        record = cls(seed, episode["observations"][0], {k: v[0] for k, v in episode["infos"].items()})
+        record.observations = list(episode["observations"])
+        record.infos = {k: list(v) for k, v in episode["infos"].items()}
+        record.actions, record.rewards = list(episode["actions"]), list(episode["rewards"])
+        record.terminations, record.truncations = list(episode["terminations"]), list(episode["truncations"])
+        return record
+
     def __len__(self) -> int:
         return len(self.actions)
 
