@@ -32,7 +32,7 @@ from tqdm import tqdm
 import octax_core
 from octax_gym.scores import iqm
 
-LOOP_FIELDS = ("save_at_evals", "checkpoint_every")  # what `train`'s loop does, flags of `main` only
+LOOP_FIELDS = ("save_at_evals", "checkpoint_every", "devices")  # what `train`'s loop does, flags of `main` only
 COMMON_COLUMNS = ("seed", "step", "update", "wall_s", "env_steps_per_s", "eval_mean_return", "eval_std",
                   "eval_ended_frac", "random_mean_return", "train_episode_return", "train_episodes")
 
@@ -59,6 +59,7 @@ class RunConfig:
     eval_max_steps: Optional[int] = None  # step cap per eval; None: the env's max_episode_steps
     save_at_evals: bool = False  # also write the params at every evaluation (checkpoints/params-step<N>...)
     checkpoint_every: int = 0  # updates between resumable checkpoints (resume/checkpoint.msgpack); 0: none
+    devices: str = ""  # "": one device; "all": every seed's envs split over every device of every process
     env_overrides: tuple[tuple[str, Any], ...] = ()  # octax_core.make overrides, e.g. max_episode_steps
 
     @property
@@ -87,6 +88,9 @@ class RunConfig:
                              f"num_minibatches = {self.num_minibatches}")
         if self.num_seeds < 1:
             raise ValueError(f"num_seeds must be at least 1, got {self.num_seeds}")
+        if self.devices not in ("", "all"):
+            raise ValueError(f"devices must be '' (one device) or 'all' (data-parallel over every device), "
+                             f"got {self.devices!r}")
         if self.checkpoint_every < 0:
             raise ValueError(f"checkpoint_every must be >= 0 (0: no checkpoints), got {self.checkpoint_every}")
 
@@ -230,8 +234,10 @@ def train(config: RunConfig, make_train: Callable, out_dir, game=None, rom=None,
     """
     config.check()
     out_dir = Path(out_dir)
+    writer = jax.process_index() == 0  # in a multi-process run, process 0 alone writes files
     out_dir.mkdir(parents=True, exist_ok=True)
-    checkpoints = Checkpoints(out_dir / "resume")
+    checkpoints = Checkpoints(out_dir / "resume", write=writer)
+    parallel = DataParallel(config) if config.devices else None
     env, eval_env, env_params = make_envs(config, game, rom)
     trainer = make_train(config, env, env_params)
     seeds = config.num_seeds
@@ -242,7 +248,7 @@ def train(config: RunConfig, make_train: Callable, out_dir, game=None, rom=None,
         make_evaluate(eval_env, env_params, config.eval_envs, eval_steps, random_act(env.num_actions), jit=False),
         seeds, in_axes=(None, 0)))
 
-    if not resume:
+    if not resume and writer:
         (out_dir / "config.json").write_text(json.dumps(
             {"algorithm": trainer.name, "env_id": env.spec.id, "command": sys.argv,
              **dataclasses.asdict(config)}, indent=2, default=str) + "\n")
@@ -252,9 +258,15 @@ def train(config: RunConfig, make_train: Callable, out_dir, game=None, rom=None,
     if resume:
         runner, start_at = checkpoints.load(runner)
         print(f"resuming {out_dir} at update {start_at['update']} of {config.num_updates}")
+    shardings = {}
+    if parallel is not None:
+        runner = parallel.place(runner)
+        eval_keys, random_keys = parallel.replicate(eval_keys), parallel.replicate(random_keys)
+        shardings = {"in_shardings": (parallel.shardings(runner),),
+                     "out_shardings": (parallel.shardings(runner), parallel.replicated)}
     compile_start = time.perf_counter()
     # Compiled ahead of time, so every timed call below runs and none compiles.
-    update = jax.jit(over_seeds(trainer.update, seeds), donate_argnums=0).lower(runner).compile()
+    update = jax.jit(over_seeds(trainer.update, seeds), donate_argnums=0, **shardings).lower(runner).compile()
     print(f"compiled the {trainer.name} update in {time.perf_counter() - compile_start:.1f} s "
           f"({seeds} seed{'s' * (seeds > 1)} x {config.num_envs} envs x {config.num_steps} steps, "
           f"{config.num_updates} updates)")
@@ -266,16 +278,18 @@ def train(config: RunConfig, make_train: Callable, out_dir, game=None, rom=None,
     title = f"{trainer.name} on {env.spec.id} ({config.num_envs} envs x {config.num_steps} steps" + (
         f", {seeds} seeds)" if seeds > 1 else ")")
     log = RunLog(out_dir, config.seeds, random_means, title, trainer.metric_names,
-                 keep_until=None if start_at is None else start_at["update"])
+                 keep_until=None if start_at is None else start_at["update"], write=writer)
     start = time.perf_counter()
     bar = tqdm(total=config.num_updates * config.batch_size * seeds, unit="step", unit_scale=True,
-               disable=not progress, desc=f"{trainer.name} {env.spec.id}" + (f" x{seeds}" if seeds > 1 else ""))
+               disable=not progress or not writer, desc=f"{trainer.name} {env.spec.id}" + (f" x{seeds}" if seeds > 1 else ""))
 
     def save_params(params, folder: Path, stem: str) -> list[Path]:
+        params = host_values(params)  # every process takes part; process 0 writes
         paths = []
         for i, seed in enumerate(config.seeds):
             path = folder / (f"{stem}.msgpack" if seeds == 1 else f"{stem}-seed{seed}.msgpack")
-            path.write_bytes(flax.serialization.to_bytes(jax.tree.map(lambda x: x[i], params)))
+            if writer:
+                path.write_bytes(flax.serialization.to_bytes(jax.tree.map(lambda x: x[i], params)))
             paths.append(path)
         return paths
 
@@ -302,7 +316,8 @@ def train(config: RunConfig, make_train: Callable, out_dir, game=None, rom=None,
             "env_steps_per_s": steps_per_s, "train_s": train_s, "train_s_per_seed": train_s / seeds,
             "random_mean_return": float(random_means.mean()), "final_eval_mean_return": float(final.mean()),
             "random_mean_returns": random_means.tolist(), "final_eval_mean_returns": final.tolist(),
-            "final_params": params if seeds > 1 else jax.tree.map(lambda x: x[0], params), "rows": log.rows}
+            "final_params": host_values(params) if seeds > 1 else jax.tree.map(lambda x: x[0], host_values(params)),
+            "rows": log.rows}
 
 
 def _loop(config: RunConfig, trainer: Trainer, update, runner, evaluate_policy, eval_keys, log: "RunLog",
@@ -346,6 +361,59 @@ def _loop(config: RunConfig, trainer: Trainer, update, runner, evaluate_policy, 
         bar.update(config.batch_size * config.num_seeds)
 
 
+class DataParallel:
+    """Data-parallel placement of a run (`devices="all"`): a 1-D mesh "envs" over every device of
+    every process; each seed's envs (the runner's env states, observations and running returns,
+    axis 1 after the seed axis) split along it, everything else (params, optimizer state, keys)
+    replicated. The update is compiled with these shardings, so XLA runs each device's envs where
+    they live and averages the loss, hence the gradients, over the whole batch with its own
+    collectives: the algorithm's code is unchanged, and the params are those of one device up to
+    the order of float sums."""
+
+    BATCH_FIELDS = ("env_state", "obs", "episode_return")
+
+    def __init__(self, config: RunConfig):
+        from jax.sharding import Mesh, NamedSharding, PartitionSpec
+
+        self.mesh = Mesh(np.array(jax.devices()), ("envs",))
+        if config.num_envs % self.mesh.size:
+            raise ValueError(f"num_envs={config.num_envs} does not divide over the {self.mesh.size} devices "
+                             f"(devices='all'); use a multiple of {self.mesh.size}")
+        self.batch = NamedSharding(self.mesh, PartitionSpec(None, "envs"))
+        self.replicated = NamedSharding(self.mesh, PartitionSpec())
+
+    def shardings(self, runner):
+        fields = {name: jax.tree.map(lambda _: self.batch if name in self.BATCH_FIELDS else self.replicated,
+                                     getattr(runner, name)) for name in runner._fields}
+        return type(runner)(**fields)
+
+    def place(self, runner):
+        """The runner (the same values on every process) as global arrays with `shardings`."""
+        shardings = self.shardings(runner)
+        host = host_values(_keys_as_data(runner))
+        placed = jax.tree.map(lambda x, s: jax.make_array_from_callback(np.shape(x), s, lambda i: np.asarray(x)[i]),
+                              host, shardings)
+        return jax.tree.map(lambda t, x: jax.random.wrap_key_data(x, impl=jax.random.key_impl(t)) if _is_key(t) else x,
+                            runner, placed)
+
+    def replicate(self, keys):
+        data = np.asarray(jax.random.key_data(keys))
+        placed = jax.make_array_from_callback(data.shape, self.replicated, lambda i: data[i])
+        return jax.random.wrap_key_data(placed, impl=jax.random.key_impl(keys))
+
+
+def host_values(tree):
+    """Every leaf as a numpy array on every process: a multi-process array that is not fully
+    replicated is gathered (`process_allgather`, a collective: every process must call this)."""
+    from jax.experimental import multihost_utils
+
+    def leaf(x):
+        if isinstance(x, jax.Array) and not x.is_fully_addressable and not x.is_fully_replicated:
+            return np.asarray(multihost_utils.process_allgather(x, tiled=True))
+        return np.asarray(x)
+    return jax.tree.map(leaf, tree)
+
+
 class Checkpoints:
     """A run's resumable checkpoint: `<out_dir>/resume/checkpoint.msgpack` (flax serialization of
     every seed's runner, typed PRNG keys as their raw data, and the loop's position: updates done,
@@ -353,13 +421,15 @@ class Checkpoints:
     position, readable). Each is written to a temporary file and renamed over the last one, so a
     kill at any moment leaves the previous checkpoint or the new one whole, never a torn file."""
 
-    def __init__(self, folder: Path):
-        self.folder = folder
+    def __init__(self, folder: Path, write: bool = True):
+        self.folder, self.write = folder, write
         self.path, self.info_path = folder / "checkpoint.msgpack", folder / "checkpoint.json"
 
     def save(self, runner, position: dict) -> None:
+        leaves = jax.tree.leaves(host_values(_keys_as_data(runner)))  # every process takes part
+        if not self.write:
+            return
         self.folder.mkdir(parents=True, exist_ok=True)
-        leaves = jax.device_get(jax.tree.leaves(_keys_as_data(runner)))
         payload = {"runner": {str(i): np.asarray(leaf) for i, leaf in enumerate(leaves)},
                    "update": position["update"], "train_s": position["train_s"],
                    "totals": {k: np.asarray(v, np.float64) for k, v in position["totals"].items()}}
@@ -408,7 +478,7 @@ class RunLog:
     """Appends one CSV row per seed and evaluation, and redraws the learning curve."""
 
     def __init__(self, out_dir: Path, seeds: Sequence[int], random_means, title: str, metric_names: Sequence[str],
-                 keep_until: Optional[int] = None):
+                 keep_until: Optional[int] = None, write: bool = True):
         """A new log; or, with `keep_until` (a resumed run's update), the existing progress.csv's rows
         up to that update, rewritten without the rows a killed run logged after its checkpoint."""
         self.csv_path, self.png_path = out_dir / "progress.csv", out_dir / "learning_curve.png"
@@ -416,6 +486,9 @@ class RunLog:
         self.title, self.metric_names, self.rows = title, tuple(metric_names), []
         self.columns = COMMON_COLUMNS + self.metric_names
         self._extra_columns: Optional[tuple[str, ...]] = None
+        self.write = write
+        if not write:
+            return
         if keep_until is not None:
             with open(self.csv_path, newline="") as f:
                 self.rows = [{k: _number(v) for k, v in row.items()} for row in csv.DictReader(f)
@@ -443,9 +516,10 @@ class RunLog:
                 row[name] = float(totals[name][i]) / n if n and name in totals else host_metrics.get(name, math.nan)
             rows.append(row)
         self.rows.extend(rows)
-        with open(self.csv_path, "a", newline="") as f:
-            csv.DictWriter(f, self.columns).writerows(rows)
-        self._plot()
+        if self.write:
+            with open(self.csv_path, "a", newline="") as f:
+                csv.DictWriter(f, self.columns).writerows(rows)
+            self._plot()
         return rows
 
     def _plot(self) -> None:
@@ -499,6 +573,9 @@ HELP = {
     "checkpoint_every": "write a resumable checkpoint (every seed's runner: params, optimizer and env state, "
                         "keys; the log so far) every N updates to <out-dir>/resume/; 0: none. --resume "
                         "<out-dir> continues a killed run to the params an uninterrupted one ends with",
+    "devices": "'all': data-parallel, every seed's envs split over every device of every process (with "
+               "--coordinator, --num-processes, --process-id for several processes), gradients averaged by "
+               "the compiled update; '': one device",
     "save_at_evals": "also write the params at every evaluation, as checkpoints/params-step<N>[-seed<S>].msgpack "
                      "(the dataset suite's medium policies come from these)",
 }
@@ -536,11 +613,20 @@ def parse_args(config_type: type, help_text: dict, description: str, runs_dir: s
                         help="for progress.csv, learning_curve.png and the params; "
                              f"None: {runs_dir}/<game>-s<seed>[-n<num_seeds>]")
     if loop_flags:
+        parser.add_argument("--coordinator", default=None, metavar="HOST:PORT",
+                            help="with --devices all over several processes: process 0's address "
+                                 "(octax_gym.distributed.initialize; without it, SLURM or torchrun-style variables)")
+        parser.add_argument("--num-processes", type=int, default=None, help="processes in the run")
+        parser.add_argument("--process-id", type=int, default=None, help="this process's rank")
         parser.add_argument("--resume", type=Path, default=None, metavar="DIR",
                             help="continue the run in DIR (made with --checkpoint-every) from its last checkpoint, "
                                  "with DIR's config.json; other flags are ignored")
     args = vars(parser.parse_args(argv))
     resume = args.pop("resume", None)
+    distributed = [args.pop(name, None) for name in ("coordinator", "num_processes", "process_id")]
+    if any(value is not None for value in distributed):
+        import octax_gym.distributed
+        octax_gym.distributed.initialize(*distributed)  # before anything computes with JAX
     if resume is not None:
         return load_config(config_type, resume / "config.json"), resume, True
     out_dir = args.pop("out_dir")
