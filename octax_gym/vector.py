@@ -81,6 +81,10 @@ class OctaxVectorEnv(gymnasium.vector.VectorEnv):
         backend: "numpy" (default), "jax" or "torch"; arrays are handed over without copies.
         device: where the env runs and its arrays live: None (JAX's default), "cpu", "cuda",
             "cuda:1", a jax.Device or a torch.device.
+        devices: the batch sharded over several devices, of this process or of every process of
+            a `jax.distributed` run: "all", a list of devices, or a Mesh with an axis "envs"
+            (`octax_gym.sharding`). `num_envs` is then the global batch; the env's `num_envs` and
+            arrays are this process's lanes, `global_env_ids` their global indices. docs/scale.md.
         render_mode: None or "rgb_array" (`render()` returns a tuple of num_envs frames).
         render_scale: pixel size of a rendered frame (default 8: 512 x 256).
         palette: a name from `octax_gym.render.PALETTES`, an (off, on) pair of RGB triples or
