@@ -9,9 +9,10 @@ The policies are PPO agents trained by the pure-JAX example with checkpoints at 
 in docs/datasets.md and `make dataset-suite` runs them). From a game's training run:
 
 - expert: the final params (`params.msgpack`), scored by the run's last evaluation;
-- medium: the checkpoint whose evaluation return is nearest a third of the way from the random
+- medium: of the checkpoints part way through training (neither the untrained network nor the
+  final one), the one whose evaluation return is nearest a third of the way from the random
   policy's return to the expert's (D4RL's "medium": a policy part way through training, about a
-  third of the expert's performance over random), the final one left out;
+  third of the expert's performance over random);
 - random: uniform actions.
 
 Each dataset's metadata.json carries its policy card (`policy`: algorithm, steps trained, its
@@ -99,9 +100,10 @@ def pick_policies(run_dir) -> dict[str, PolicyCard]:
                           random_return, command)
 
     target = random_return + MEDIUM_FRACTION * (expert_return - random_return)
-    candidates = [step for step in checkpoints if step in evals and step != final_step]
+    candidates = [step for step in checkpoints if step in evals and 0 < step < final_step]  # part way through
     if not candidates:
-        raise FileNotFoundError(f"{run_dir}: no checkpoint before the final one with an evaluation in progress.csv")
+        raise FileNotFoundError(f"{run_dir}: no checkpoint between the start and the end of training with an "
+                                "evaluation in progress.csv")
     medium = min(candidates, key=lambda step: (abs(evals[step] - target), step))
     return {"medium": card("medium", checkpoints[medium], medium),
             "expert": card("expert", run_dir / "params.msgpack", final_step)}

@@ -43,6 +43,9 @@ def fake_run(folder: Path, evals: dict[int, float], random_return: float = 1.0, 
 def test_medium_is_the_checkpoint_nearest_a_third_of_the_way_and_expert_the_final_one(tmp_path):
     # random 1, expert 10: a third of the way is 4; 3.5 is nearer than 5.0
     run = fake_run(tmp_path / "Flak", {0: 1.0, 100: 2.0, 200: 3.5, 300: 5.0, 400: 9.0, 500: 10.0})
+    # the untrained network is never the medium policy, even when nearest the target
+    early = fake_run(tmp_path / "Squash", {0: -5.0, 100: -0.9, 200: -0.8}, random_return=-5.0)
+    assert suite.pick_policies(early)["medium"].steps_trained == 100
     cards = suite.pick_policies(run)
     assert cards["expert"].steps_trained == 500 and cards["expert"].eval_return == 10.0
     assert cards["expert"].params_path == run / "params.msgpack"
