@@ -20,6 +20,7 @@ import asyncio
 import collections
 import json
 import logging
+import signal
 import threading
 import time
 from pathlib import Path
@@ -252,6 +253,10 @@ class PlayServer:
             finally:
                 await runner.cleanup()
 
+        if threading.current_thread() is threading.main_thread():
+            # Ctrl-C stops the server even where this process was started with SIGINT ignored (a
+            # shell's background job, a nohup'd script), which Python would otherwise keep.
+            signal.signal(signal.SIGINT, signal.default_int_handler)
         try:
             asyncio.run(main())
         except KeyboardInterrupt:

@@ -70,6 +70,7 @@ def test_two_processes_train_the_params_of_one_process_with_two_devices(tmp_path
     assert all(np.allclose(a, b, rtol=1e-4, atol=1e-4) for a, b in zip(one, two))  # sums in another order
 
 
+@pytest.mark.slow  # a JAX start-up in a subprocess for one message
 def test_a_batch_that_does_not_divide_is_refused(tmp_path):
     out = start(tmp_path / "odd", "--devices", "all", "--num-envs", "3", devices=2).communicate(timeout=TIMEOUT_S)[0]
     assert "num_envs=3 does not divide over the 2 devices" in out

@@ -33,6 +33,7 @@ def test_shard_plans_split_the_steps_and_keep_seeds_apart():
         shard_plan(2, 4, 0, 0, 3)
 
 
+@pytest.mark.slow  # two collecting processes and a replay (~30 s); CI's test-slow runs it
 def test_two_processes_collect_shards_that_combine_into_a_dataset_that_replays(tmp_path, monkeypatch, capsys):
     data = tmp_path / "minari"
     env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(REPO), os.environ.get("PYTHONPATH", "")])}

@@ -77,6 +77,7 @@ def test_two_processes_each_step_their_lanes_of_the_global_batch(tmp_path, refer
     assert reference["terminated"].any()  # episodes ended (and were reset) inside the compared steps
 
 
+@pytest.mark.slow  # two more JAX start-ups in subprocesses; the 2-process test above runs in `make test`
 def test_one_process_with_two_devices_equals_one_device(tmp_path, reference):
     flags = {"XLA_FLAGS": "--xla_force_host_platform_device_count=2"}
     finish(run([str(REPO / "tests" / "distributed_worker.py"), str(tmp_path / "two.npz"), "-", "0", "0"], flags))
