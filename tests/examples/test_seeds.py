@@ -22,6 +22,7 @@ SETTINGS = dict(num_envs=6, num_steps=8, num_minibatches=2, update_epochs=2, tot
                 eval_every=96, eval_envs=5, env_overrides=(("max_episode_steps", 12),))
 
 
+@pytest.mark.slow  # a long check (>20 s on 2 cores); CI's test-slow runs it
 @pytest.mark.parametrize("algorithm", [ppo, pqn], ids=["ppo", "pqn"])
 def test_each_seed_of_a_batched_run_learns_what_it_learns_alone(algorithm, counter_rom, tmp_path):
     together = algorithm.train(algorithm.Config(seed=10, num_seeds=3, **SETTINGS), tmp_path / "together",

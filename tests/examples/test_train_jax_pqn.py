@@ -116,6 +116,7 @@ def test_main_writes_csv_and_plot_per_seed(tmp_path):
     assert summary["env_steps_per_s"] > 0
 
 
+@pytest.mark.slow  # a long check (>20 s on 2 cores); CI's test-slow runs it
 def test_pqn_learns_to_press_2(counter_rom, tmp_path):
     config = pqn.Config(num_envs=16, num_steps=8, num_minibatches=2, total_steps=16 * 8 * 40,
                         learning_rate=1e-3, eval_every=0, eval_envs=32, eval_epsilon=0.0)

@@ -177,6 +177,7 @@ def test_only_bench_takes_arguments_it_does_not_declare(capsys):
     assert exc.value.code == 2 and "unrecognized arguments: --envs 2" in capsys.readouterr().err
 
 
+@pytest.mark.slow  # a long check (>20 s on 2 cores); CI's test-slow runs it
 def test_env_loop_prints_one_line_per_case_against_the_machine_and_octax():
     result = subprocess.run(
         [sys.executable, "benchmarks/env_loop.py", "--envs", "2", "--steps", "2", "--repeats", "1",

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import pytest
 import subprocess
 import sys
 from pathlib import Path
@@ -16,6 +17,7 @@ def _run(*argv):
                           timeout=600, cwd=REPO, check=False)
 
 
+@pytest.mark.slow  # a long check (>20 s on 2 cores); CI's test-slow runs it
 def test_mix_prints_each_game_and_the_mix_against_their_mean(octax_rom_dir):
     result = _run("--games", "Pong,Brix", "--envs", "4", "--steps", "2", "--repeats", "1")
     assert result.returncode == 0, result.stderr

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import pytest
 import subprocess
 import sys
 from pathlib import Path
@@ -16,6 +17,7 @@ def _run(*argv):
                           timeout=300, cwd=REPO, check=False)
 
 
+@pytest.mark.slow  # a long check (>20 s on 2 cores); CI's test-slow runs it
 def test_two_player_prints_one_line_per_game_and_n_with_both_sides(octax_rom_dir):
     result = _run("--games", "SpaceRacer", "--envs", "2,3", "--steps", "2", "--repeats", "1")
     assert result.returncode == 0, result.stderr
