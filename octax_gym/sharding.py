@@ -80,8 +80,9 @@ class Shards:
 
     def keys(self, local_seeds: Sequence[int]) -> jax.Array:
         """The global batch of typed PRNG keys, `jax.random.key(seed)` for each of this process's lanes."""
-        data = np.stack([np.asarray(jax.random.key_data(jax.random.key(int(s)))) for s in local_seeds])
-        return jax.random.wrap_key_data(self.to_global(data))
+        from octax_gym.compiled_step import keys_from_seeds
+
+        return jax.random.wrap_key_data(self.to_global(jax.random.key_data(keys_from_seeds(list(local_seeds)))))
 
     def replicate(self, tree):
         """Every leaf copied whole to every device of the mesh (the env's params)."""
