@@ -37,24 +37,31 @@ def check_backend(backend: str) -> str:
 def resolve_device(device: Any) -> jax.Device:
     """None (JAX's default), a jax.Device, a torch.device, or "cpu", "gpu", "cuda", "cuda:1", "tpu".
 
+    "cuda:1" is this process's second GPU, as in torch; in a multi-process run
+    (`octax_gym.distributed`) a device's global name as JAX prints it ("cpu:2048") works too.
+
     Raises:
-        UnknownOptionError: no such device here; the message lists the available ones.
+        UnknownOptionError: no such device in this process; the message lists the available ones.
     """
     if device is None:
-        return jax.devices()[0]
+        return jax.local_devices()[0]
     if isinstance(device, jax.Device):
         return device
     text = str(device)  # torch.device("cuda:0") prints as "cuda:0"
     platform, _, index = text.partition(":")
     platform = {"cuda": "gpu", "rocm": "gpu"}.get(platform.lower(), platform.lower())
-    available = [f"{d.platform}:{d.id}" for d in jax.devices()] + [f"cpu:{d.id}" for d in _cpu_devices()]
+    local = jax.local_devices()
+    available = [f"{d.platform}:{d.id}" for d in local] + [f"cpu:{d.id}" for d in _cpu_devices() if d not in local]
     try:
-        devices = jax.devices(platform)
+        devices = jax.local_devices(backend=platform)
     except RuntimeError:
         devices = []
     if not index.isdigit() and index:
         devices = []
     position = int(index) if index else 0
+    by_id = [d for d in devices if d.id == position]
+    if by_id:
+        return by_id[0]
     if position >= len(devices):
         raise UnknownOptionError("or unavailable device", device, dict.fromkeys(available),
                                  "or a jax.Device or torch.device")
@@ -63,7 +70,7 @@ def resolve_device(device: Any) -> jax.Device:
 
 def _cpu_devices():
     try:
-        return jax.devices("cpu")
+        return jax.local_devices(backend="cpu")
     except RuntimeError:
         return []
 

@@ -35,7 +35,13 @@ def main(out, coordinator, num_processes, rank):
     import gymnasium as gym
     import octax_gym
     gym.register_envs(octax_gym)
-    np.savez(out, **play(lambda: gym.make_vec(f"octax/{GAME}-v0", num_envs=NUM_ENVS, devices="all")))
+    import jax
+    from octax_gym.backends import resolve_device
+    local = jax.local_devices()
+    # a device named as JAX prints it ("cpu:2048" on process 1) or by its place here ("cpu") is this process's
+    named = [resolve_device(f"{d.platform}:{d.id}") == d for d in local] + [resolve_device("cpu") == local[0]]
+    np.savez(out, names_resolve=np.array(named),
+             **play(lambda: gym.make_vec(f"octax/{GAME}-v0", num_envs=NUM_ENVS, devices="all")))
 
 
 if __name__ == "__main__":

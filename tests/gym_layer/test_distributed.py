@@ -74,6 +74,8 @@ def test_two_processes_each_step_their_lanes_of_the_global_batch(tmp_path, refer
         finish(process)
     ids = [check_lanes(tmp_path / f"rank{rank}.npz", reference) for rank in range(2)]
     assert [list(i) for i in ids] == [[0, 1], [2, 3]]  # rank r holds lanes 2r, 2r + 1: the global batch once
+    for rank in range(2):  # device names resolve to the process's own devices (rank 1's ids are not 0)
+        assert np.load(tmp_path / f"rank{rank}.npz")["names_resolve"].all()
     assert reference["terminated"].any()  # episodes ended (and were reset) inside the compared steps
 
 
@@ -101,7 +103,7 @@ def test_a_coordinator_that_never_answers_is_a_named_error_not_a_hang():
 
 
 def test_bad_meshes_and_device_arguments_are_named():
-    with pytest.raises(ValueError, match="the mesh has axes \('batch',\); the batch is split along one named 'envs'"):
+    with pytest.raises(ValueError, match=r"the mesh has axes \('batch',\); the batch is split along one named 'envs'"):
         sharding.Shards(Mesh(np.array(jax.devices()), ("batch",)), 4)
     with pytest.raises(ValueError, match="names a device twice"):
         sharding.Shards(["cpu:0", "cpu:0"], 4)
