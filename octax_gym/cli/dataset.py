@@ -3,6 +3,7 @@
     octax-gym dataset collect Brix --dataset-id octax/Brix-random-v0 --steps 100000 --envs 64
     octax-gym dataset collect Pong --dataset-id octax/Pong-noop-v0 --steps 5000 --policy noop --data-path /tmp/minari
     octax-gym dataset suite --runs runs/suite          # octax/<Game>/{random,medium,expert}-v0
+    octax-gym dataset finish octax/Brix-random-v0      # a killed collection's parts as one file
 
 A thin layer over `octax_gym.datasets.collect_dataset`, which checks the arguments (its errors
 name the valid choices) and is imported only when the command runs: it brings JAX and Minari.
@@ -67,6 +68,16 @@ def add_commands(commands: argparse._SubParsersAction) -> None:
     combine.add_argument("--overwrite", action="store_true", help="replace a dataset of that id")
     combine.set_defaults(func=_cmd_combine)
 
+    finish = sub.add_parser("finish", help="make a killed collection's dataset one file",
+                            description="A collection killed part way leaves a readable dataset of the episodes it "
+                                        "wrote, its main_data.hdf5 linking to files under data/parts/. This copies "
+                                        "them into one self-contained main_data.hdf5, as a finished collection "
+                                        "leaves it. Safe to interrupt and run again. See docs/datasets.md.")
+    finish.add_argument("dataset", metavar="ID_OR_DIR", help="the dataset's id, or its folder (the one holding data/)")
+    finish.add_argument("--data-path", type=Path, metavar="DIR", help=f"look under DIR instead of "
+                                                                      f"${DATASETS_PATH_VARIABLE}")
+    finish.set_defaults(func=_cmd_finish)
+
     from octax_gym.datasets import suite  # no JAX or Minari: names and defaults only
 
     build = sub.add_parser(
@@ -123,6 +134,21 @@ def _cmd_combine(args: argparse.Namespace) -> int:
         path = Path(dataset.storage.data_path).parent
     print(f"wrote {args.dataset_id}: {dataset.total_episodes} episodes, {dataset.total_steps} steps from "
           f"{len(args.shards)} shards, {_megabytes(path):,.1f} MB at {path}")
+    return 0
+
+
+def _cmd_finish(args: argparse.Namespace) -> int:
+    from octax_gym.datasets import finish_dataset
+    from octax_gym.datasets.storage import import_minari
+
+    minari = import_minari()
+    with _datasets_path(args.data_path):
+        changed = finish_dataset(args.dataset)
+        folder = Path(args.dataset)
+        dataset = minari.MinariDataset(folder / "data") if (folder / "data").is_dir() else \
+            minari.load_dataset(args.dataset)
+    state = "made one file" if changed else "already one file"
+    print(f"{args.dataset}: {state}; {dataset.total_episodes} episodes, {dataset.total_steps} steps")
     return 0
 
 

@@ -22,7 +22,7 @@ import importlib
 _EXPORTS = {
     "CollectResult": "collect", "FLUSH_STEPS": "collect", "collect_dataset": "collect", "episode_seed": "collect",
     "recovery_spec": "collect",
-    "DatasetWriter": "storage", "EpisodeRecord": "storage", "INSTALL_HINT": "storage",
+    "DatasetWriter": "storage", "EpisodeRecord": "storage", "INSTALL_HINT": "storage", "finish_dataset": "storage",
     "Batch": "transitions", "Transitions": "transitions", "load_transitions": "transitions",
     "build_suite": "suite", "pick_policies": "suite",
     "combine_datasets": "combine", "shard_plan": "combine",

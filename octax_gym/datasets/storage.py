@@ -15,13 +15,29 @@ unchanged and bit for bit: nothing here to decode. The metadata's `observation_f
 the observations are stored. Brix random play: 9,377 bytes a step written by Minari, about 125
 here (benchmarks/datasets.py).
 
-Episodes are appended with h5py in groups of at least `flush_steps` steps (memory holds one group),
-and the metadata's totals are updated after each group, so a dataset interrupted between groups is
-still a readable dataset of the episodes written so far.
+A collection can be killed at any instant (a cluster's preemption, SIGKILL, Ctrl-C) and leave a
+readable dataset of the episodes it had written, or no dataset, never a damaged one. Every file is
+written under a temporary name and renamed into place (an atomic step on POSIX), never changed in
+place:
+- the dataset is created (Minari's metadata) in a hidden staging folder under the datasets root,
+  then its folder is renamed to the dataset's path: before that there is no dataset;
+- finished episodes are written in groups of at least `flush_steps` steps (memory holds one group),
+  each group to a file of its own, `data/parts/part-NNNNN.hdf5`;
+- then `main_data.hdf5` is replaced by a copy that adds an HDF5 external link `episode_<id>` to
+  each new episode's group in its part (HDF5 resolves it beside the file, and h5py and Minari read
+  through links as through groups), then `metadata.json` by a copy with the new totals;
+- `close()` copies every episode into one self-contained `main_data.hdf5` (HDF5's object copy,
+  compressed chunks as they are), renames it into place and deletes the parts.
+A collection killed part way is a dataset of links into its parts, readable as it is;
+`finish_dataset` turns it into the one-file form `close()` leaves.
 """
 
 from __future__ import annotations
 
+import json
+import os
+import secrets
+import shutil
 import warnings
 from pathlib import Path
 from typing import Any, Optional
@@ -39,6 +55,9 @@ CHUNK_STEPS = 64  # observations per HDF5 chunk (the unit compressed and read ba
 # HDF5's newest object formats: smaller per-dataset headers and chunk indexes than the 1.8-compatible
 # default, which matters for short episodes (a random Brix episode is 33 steps). HDF5 >= 1.10 reads it.
 LIBVER = "latest"
+PARTS = "parts"  # data/parts/: a killed collection's episodes, linked from main_data.hdf5
+MAIN_DATA, METADATA = "main_data.hdf5", "metadata.json"
+STAGING = ".octax-incomplete"  # under the datasets root; hidden, so Minari's listing skips it
 
 
 class EpisodeRecord:
@@ -107,21 +126,22 @@ class DatasetWriter:
 
     def __init__(self, dataset_id: str, env_spec, observation_space, action_space, flush_steps: int,
                  metadata: dict[str, Any], extra_metadata: Optional[dict[str, Any]] = None, compress: bool = True):
-        minari = import_minari()
+        import_minari()
+        from minari.storage import get_dataset_path
+
         given = {name: value for name, value in metadata.items() if value is not None}
-        with warnings.catch_warnings():  # Minari's "author is None, recommended" notes: optional here
-            warnings.filterwarnings("ignore", message=r".*is set to None", category=UserWarning)
-            dataset = minari.create_dataset_from_buffers(
-                dataset_id, [], env=env_spec, observation_space=observation_space, action_space=action_space,
-                requirements=["octax-gym"], data_format="hdf5", jpeg_encoding=False, **given)
-        self._storage = dataset.storage
-        self.path = Path(dataset.storage.data_path)  # <dataset>/data
+        final = Path(get_dataset_path(dataset_id))
+        if final.exists():  # Minari's own refusal, before any work
+            raise ValueError(f"A Minari dataset with ID {dataset_id} already exists and it cannot be overridden. "
+                             f"Please use a different dataset name or version.")
+        extra = {"observation_filters": FILTERS_NAME if compress else "none", **(extra_metadata or {})}
+        self.path = _create(dataset_id, final, dict(env=env_spec, observation_space=observation_space,
+                                                    action_space=action_space, **given), extra) / "data"
         self._filters = OBSERVATION_FILTERS if compress else {}
-        self._storage.update_metadata({"observation_filters": FILTERS_NAME if compress else "none",
-                                       **(extra_metadata or {})})
         self._flush_steps = flush_steps
         self._pending: list[tuple[int, dict]] = []  # (seed, arrays) not yet written
         self._pending_steps = 0
+        self._parts = 0
         self.episodes = self.steps = 0
 
     def add(self, episode: EpisodeRecord, cut: bool) -> None:
@@ -131,27 +151,40 @@ class DatasetWriter:
             self.flush()
 
     def close(self):
-        """Writes what is left; returns the `minari.MinariDataset`."""
+        """Writes what is left, makes `main_data.hdf5` one self-contained file; returns the
+        `minari.MinariDataset`."""
         self.flush()
+        finish_dataset(self.path.parent)
         import minari
 
         return minari.MinariDataset(self.path)
 
     def flush(self) -> None:
-        """Writes the pending episodes, then the metadata's totals (so the dataset on disk is whole
-        after every flush)."""
+        """Writes the pending episodes to a new part, links them from `main_data.hdf5`, then writes
+        the metadata's totals; each file is renamed into place whole, so the dataset on disk is
+        whole at every instant."""
         if not self._pending:
             return
         import h5py
 
-        with h5py.File(self.path / "main_data.hdf5", "a", libver=LIBVER, track_order=True) as file:
-            for seed, arrays in self._pending:
-                self._write_episode(file, self.episodes, seed, arrays)
-                self.episodes += 1
-                self.steps += len(arrays["actions"])
+        part = Path(PARTS) / f"part-{self._parts:05d}.hdf5"
+        (self.path / PARTS).mkdir(exist_ok=True)
+        first = self.episodes
+        with _replacing(self.path / part) as tmp:
+            with h5py.File(tmp, "w", libver=LIBVER, track_order=True) as file:
+                for i, (seed, arrays) in enumerate(self._pending):
+                    self._write_episode(file, first + i, seed, arrays)
+        with _replacing(self.path / MAIN_DATA) as tmp:
+            shutil.copyfile(self.path / MAIN_DATA, tmp)
+            with h5py.File(tmp, "a", libver=LIBVER, track_order=True) as file:
+                for i in range(first, first + len(self._pending)):
+                    file[f"episode_{i}"] = h5py.ExternalLink(part.as_posix(), f"/episode_{i}")
+        self._parts += 1
+        self.episodes += len(self._pending)
+        self.steps += sum(len(arrays["actions"]) for _, arrays in self._pending)
         self._pending, self._pending_steps = [], 0
-        self._storage.update_metadata({"total_episodes": self.episodes, "total_steps": self.steps,
-                                       "dataset_size": self._storage.get_size()})
+        update_metadata(self.path, {"total_episodes": self.episodes, "total_steps": self.steps,
+                                    "dataset_size": data_size(self.path)})
 
     def _write_episode(self, file, episode_id: int, seed: int, arrays: dict[str, Any]) -> None:
         group = file.create_group(f"episode_{episode_id}")
@@ -166,6 +199,160 @@ class DatasetWriter:
         infos = group.create_group("infos")
         for name, values in arrays["infos"].items():
             infos.create_dataset(name, data=values)
+
+
+def finish_dataset(dataset) -> bool:
+    """Makes a dataset written in parts (a collection killed part way, or one being closed) one
+    self-contained `main_data.hdf5`: every linked episode copied in (HDF5's object copy moves the
+    compressed chunks as they are), the file renamed into place, then the parts deleted. Safe to
+    kill at any point and to run again. Returns False when there was nothing to do.
+
+    Args:
+        dataset: a dataset id ("octax/Brix-random-v0", under Minari's datasets root) or the
+            dataset's folder (the one holding data/).
+
+    Raises:
+        FileNotFoundError: no such dataset.
+    """
+    import h5py
+
+    folder = Path(dataset)
+    if not (folder / "data").is_dir():
+        from minari.storage import get_dataset_path
+
+        folder = Path(get_dataset_path(str(dataset)))
+        if not (folder / "data").is_dir():
+            raise FileNotFoundError(f"no dataset {str(dataset)!r}: neither a dataset folder (with data/) nor a "
+                                    f"dataset id under {get_dataset_path()}")
+    data = folder / "data"
+    parts = data / PARTS
+    if not parts.exists():
+        return False
+    with h5py.File(data / MAIN_DATA, "r") as linked:
+        names = list(linked.keys())
+        links = {name: linked.get(name, getlink=True) for name in names}
+    if any(isinstance(link, h5py.ExternalLink) for link in links.values()):
+        with _replacing(data / MAIN_DATA) as tmp:
+            with h5py.File(tmp, "w", libver=LIBVER, track_order=True) as out:
+                sources: dict[str, Any] = {}
+                try:
+                    for name in names:
+                        link = links[name]
+                        if not isinstance(link, h5py.ExternalLink):
+                            raise ValueError(f"{data / MAIN_DATA}: {name} is not a link into {PARTS}/")
+                        if link.filename not in sources:
+                            sources[link.filename] = h5py.File(data / link.filename, "r")
+                        sources[link.filename].copy(link.path, out, name=name)
+                finally:
+                    for source in sources.values():
+                        source.close()
+    shutil.rmtree(parts)
+    update_metadata(data, {"dataset_size": data_size(data)})
+    return True
+
+
+def update_metadata(data_path: Path, changes: dict[str, Any]) -> None:
+    """metadata.json with `changes`, written whole under a temporary name and renamed into place
+    (Minari's own update rewrites the file in place, which a kill can leave half-written)."""
+    from minari.dataset.minari_storage import _json_converter
+
+    path = Path(data_path) / METADATA
+    metadata = json.loads(path.read_text())
+    metadata.update(changes)
+    with _replacing(path) as tmp:
+        tmp.write_text(json.dumps(metadata, default=_json_converter))
+
+
+def data_size(data_path: Path) -> float:
+    """The dataset's size in MB, as Minari counts it (every file under data/)."""
+    return sum(f.stat().st_size for f in Path(data_path).glob("**/*") if f.is_file()) / 1e6
+
+
+class _replacing:
+    """`with _replacing(path) as tmp:` write `tmp`; on success it is synced and renamed to `path`
+    (and the folder synced), on an exception removed. A kill at any point leaves `path` as it was
+    or as the whole new file."""
+
+    def __init__(self, path: Path):
+        self.path = Path(path)
+        self.tmp = self.path.with_name(f".{self.path.name}.{os.getpid()}.{secrets.token_hex(4)}.tmp")
+
+    def __enter__(self) -> Path:
+        return self.tmp
+
+    def __exit__(self, kind, value, traceback):
+        if kind is not None:
+            self.tmp.unlink(missing_ok=True)
+            return False
+        with open(self.tmp, "rb") as f:
+            os.fsync(f.fileno())
+        os.replace(self.tmp, self.path)
+        _sync_dir(self.path.parent)
+        return False
+
+
+def _sync_dir(path: Path) -> None:
+    try:
+        fd = os.open(path, os.O_RDONLY)
+    except OSError:  # some filesystems cannot open a folder; the rename is atomic regardless
+        return
+    try:
+        os.fsync(fd)
+    except OSError:
+        pass
+    finally:
+        os.close(fd)
+
+
+def _create(dataset_id: str, final: Path, arguments: dict[str, Any], extra: dict[str, Any]) -> Path:
+    """The dataset created by Minari (its metadata.json, an empty main_data.hdf5) in a hidden
+    staging folder of the datasets root, completed, then renamed to `final`: there is a dataset at
+    `final` only once it is whole. Returns `final`."""
+    import minari
+    from minari.namespace import create_namespace, list_local_namespaces
+    from minari.storage import get_dataset_path
+    from minari.utils import parse_dataset_id
+
+    root = Path(get_dataset_path())
+    staging = root / STAGING / f"{os.getpid()}-{secrets.token_hex(4)}"
+    before = os.environ.get("MINARI_DATASETS_PATH")
+    os.environ["MINARI_DATASETS_PATH"] = str(staging)  # Minari places a new dataset under this root
+    try:
+        with warnings.catch_warnings():  # Minari's "author is None, recommended" notes: optional here
+            warnings.filterwarnings("ignore", message=r".*is set to None", category=UserWarning)
+            dataset = minari.create_dataset_from_buffers(dataset_id, [], requirements=["octax-gym"],
+                                                         data_format="hdf5", jpeg_encoding=False, **arguments)
+        built = Path(dataset.storage.data_path)
+    finally:
+        if before is None:
+            os.environ.pop("MINARI_DATASETS_PATH", None)
+        else:
+            os.environ["MINARI_DATASETS_PATH"] = before
+    try:
+        update_metadata(built, extra)
+        if not (built / MAIN_DATA).exists():  # Minari writes no file for an empty buffer list
+            import h5py
+
+            with _replacing(built / MAIN_DATA) as tmp:
+                h5py.File(tmp, "w", libver=LIBVER, track_order=True).close()
+        namespace = parse_dataset_id(dataset_id)[0]
+        if namespace and namespace not in list_local_namespaces():
+            try:
+                create_namespace(namespace)
+            except ValueError:  # another process (a shard of the same run) made it first
+                pass
+        final.parent.mkdir(parents=True, exist_ok=True)
+        try:
+            os.rename(built.parent, final)
+        except OSError as exc:  # another writer took the id in the meantime
+            if final.exists():
+                raise ValueError(f"A Minari dataset with ID {dataset_id} already exists and it cannot be "
+                                 f"overridden. Please use a different dataset name or version.") from exc
+            raise
+        _sync_dir(final.parent)
+    finally:
+        shutil.rmtree(staging, ignore_errors=True)
+    return final
 
 
 def import_minari():
