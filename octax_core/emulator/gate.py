@@ -10,6 +10,12 @@ gets a plain `lax.cond`.
 The contract that keeps it exact: `fn(operands)` must give back `operands` unchanged, bit for
 bit, on a machine whose predicate is false. Then running it for the whole batch, or skipping
 it, changes nothing for any machine, and no select over the (large) operands is needed.
+
+The skip pays on a CPU, where the batch's work is the time. On a GPU the loop's predicate is read
+back to the host before each trip (a device-to-host sync, three gates an instruction), which cost
+more than the work it skips: there the work simply runs for the whole batch, which the contract
+makes the same. `LOOPED_PLATFORMS` names where the gate loops; `jax.lax.platform_dependent`
+picks per platform when the program is lowered, so one traced program serves both.
 """
 
 from __future__ import annotations
@@ -20,6 +26,9 @@ import jax
 import jax.numpy as jnp
 
 T = TypeVar("T")
+
+# Platforms where a batch skips the gated work when no machine needs it; elsewhere it always runs.
+LOOPED_PLATFORMS: tuple[str, ...] = ("cpu",)
 
 
 def when_any(pred: jax.Array, fn: Callable[[T, object], T], operands: T, inputs=()) -> T:
@@ -35,7 +44,7 @@ def when_any(pred: jax.Array, fn: Callable[[T, object], T], operands: T, inputs=
 
     @jax.custom_batching.custom_vmap
     def gated(pred, operands, inputs):
-        return _at_most_once(pred, fn, operands, inputs)
+        return _per_platform(pred, fn, operands, inputs)
 
     @gated.def_vmap
     def gated_batched(axis_size, in_batched, pred, operands, inputs):
@@ -43,10 +52,24 @@ def when_any(pred: jax.Array, fn: Callable[[T, object], T], operands: T, inputs=
         operands, inputs = (_batch(tree, batched, axis_size)
                             for tree, batched in ((operands, operands_batched), (inputs, inputs_batched)))
         anyone = jnp.any(pred) if pred_batched else pred
-        out = _at_most_once(anyone, jax.vmap(fn), operands, inputs)
+        out = _per_platform(anyone, jax.vmap(fn), operands, inputs)
         return out, jax.tree.map(lambda _: True, out)
 
     return gated(pred, operands, inputs)
+
+
+def _per_platform(pred, fn, operands, inputs):
+    """The loop of `_at_most_once` on `LOOPED_PLATFORMS`, `fn` unconditionally elsewhere."""
+    def always(pred, operands, inputs):
+        return fn(operands, inputs)
+
+    def looped(pred, operands, inputs):
+        return _at_most_once(pred, fn, operands, inputs)
+
+    if not LOOPED_PLATFORMS:
+        return always(pred, operands, inputs)
+    return jax.lax.platform_dependent(pred, operands, inputs, default=always,
+                                      **{platform: looped for platform in LOOPED_PLATFORMS})
 
 
 def _at_most_once(pred, fn, operands, inputs):

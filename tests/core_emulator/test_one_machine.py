@@ -151,3 +151,70 @@ def test_shown_is_the_picture_of_the_mode():
     assert bool(state.extension.hires) and not np.asarray(state.screen).any()
     np.testing.assert_array_equal(np.asarray(shown(state)), np.asarray(state.extension.grid))
     assert octax_core.render_text(state).splitlines()[0][:9] == "########."
+
+
+def test_off_the_looped_platforms_the_work_always_runs(monkeypatch):
+    """Where the gate does not loop (a GPU: `LOOPED_PLATFORMS` leaves it out), `fn` runs for the
+    whole batch even when no machine asks (shown by a work that breaks the contract on purpose);
+    with the contract kept, the result is the looped one."""
+    from octax_core.emulator import gate
+
+    monkeypatch.setattr(gate, "LOOPED_PLATFORMS", ())
+    run = jax.jit(jax.vmap(lambda pred, x: when_any(pred, lambda o, i: o + 1, x)))
+    np.testing.assert_array_equal(run(jnp.zeros(4, bool), jnp.zeros(4, jnp.int32)), [1, 1, 1, 1])
+    one = jax.jit(lambda pred, x: when_any(pred, _add_where, x, (pred, jnp.int32(5))))
+    assert int(one(True, jnp.int32(1))) == 6 and int(one(False, jnp.int32(1))) == 1
+    kept = jax.jit(jax.vmap(lambda pred, x, amount: when_any(pred, _add_where, x, (pred, amount))))
+    pred = jnp.array([False, True, False, False, True, False])
+    x = jnp.arange(6, dtype=jnp.int32)
+    np.testing.assert_array_equal(kept(pred, x, jnp.full(6, 7, jnp.int32)), np.where(pred, x + 7, x))
+
+
+# SUPER-CHIP and XO-CHIP archive programs that draw in hires, scroll and switch modes
+GATED_PROGRAMS = ("sens8tion", "superOctoTrackXO",  # SUPER-CHIP, XO-CHIP; two more in make test-slow
+                  pytest.param("sweetcopter", marks=pytest.mark.slow), pytest.param("OctoPartyMix", marks=pytest.mark.slow))
+
+
+@pytest.mark.parametrize("name", GATED_PROGRAMS)
+def test_the_gpu_form_of_the_gates_plays_the_same_batch(name, monkeypatch):
+    """The batched machine with every gate always running (the form GPUs get) equals the looped
+    form bit for bit: 4 machines, each with its own key schedule, 96 frames, every state field and
+    recorded picture."""
+    import json
+
+    from octax_core.emulator import gate
+    from octax_core.emulator.quirks import quirks_from_octo
+    from octax_core.env.romstore import ARCHIVE_ROM_DIR
+
+    entry = json.loads((ARCHIVE_ROM_DIR / "programs.json").read_text())[name]
+    rom = (ARCHIVE_ROM_DIR / f"{name}.ch8").read_bytes()
+    options = entry["options"]
+    holds = np.array([[(1 << ((h + m * 3) % 16)) if (h + m) % 2 else 0 for h in range(12)] for m in range(4)],
+                     np.uint32)  # machine m holds key ... for 8 frames, then nothing, each its own schedule
+
+    def play():
+        frame.frame_runner.cache_clear()  # a new trace, which reads LOOPED_PLATFORMS
+        machine = octax_core.Machine(entry["platform"], quirks=quirks_from_octo(options),
+                                     instructions_per_frame=int(options.get("tickrate", 20)))
+        state = jax.vmap(lambda k: machine.boot(rom, k))(jax.random.split(jax.random.key(3), 4))
+        step = jax.jit(jax.vmap(lambda s, k: machine.run_frames(s, k, 8, record_screens=True)))
+        loops = step.lower(state, jnp.asarray(holds[:, 0])).as_text().count("stablehlo.while")
+        pictures = []
+        for h in range(holds.shape[1]):
+            state, screens = step(state, jnp.asarray(holds[:, h]))
+            pictures.append(np.asarray(screens))
+        return state, np.concatenate(pictures, axis=1), loops
+
+    looped_state, looped_pictures, looped_loops = play()
+    monkeypatch.setattr(gate, "LOOPED_PLATFORMS", ())
+    always_state, always_pictures, always_loops = play()
+    frame.frame_runner.cache_clear()
+    if jax.default_backend() in gate.LOOPED_PLATFORMS:  # (elsewhere both runs are the always form)
+        assert always_loops < looped_loops  # the gates' loops are gone from the program
+    assert looped_pictures.any()
+    np.testing.assert_array_equal(always_pictures, looped_pictures)
+    for path, a, b in zip(jax.tree_util.tree_flatten_with_path(looped_state)[0],
+                          jax.tree.leaves(always_state), jax.tree.leaves(looped_state)):
+        if jnp.issubdtype(a.dtype, jax.dtypes.prng_key):
+            a, b = jax.random.key_data(a), jax.random.key_data(b)
+        np.testing.assert_array_equal(np.asarray(a), np.asarray(b), err_msg=str(path[0]))
