@@ -99,7 +99,7 @@ class Fetched(NamedTuple):
     fields: Decoded
     kind: jax.Array  # int32 Kind; STALL while the frame is over (display wait)
     context: Context
-    at_i: jax.Array  # int32 bytes at I: the 16 of the window, or 32 (a 16x16 sprite) after CHIP-8
+    at_i: jax.Array  # int32 bytes at I: the 16 of the window, 32 (a 16x16 sprite) on SUPER-CHIP, 64 (two) on XO-CHIP
 
 
 def fetch(platform: Platform, quirks: Quirks, state: MachineState, keys, stalled=None) -> Fetched:
@@ -112,7 +112,7 @@ def fetch(platform: Platform, quirks: Quirks, state: MachineState, keys, stalled
     """
     pc, I = state.pc.astype(jnp.int32), state.I.astype(jnp.int32)
     code = jax.lax.dynamic_slice(state.memory, (pc + MEMORY_OFFSET,), (platform.fetch_bytes,)).astype(jnp.int32)
-    at_i = jax.lax.dynamic_slice(state.memory, (I + MEMORY_OFFSET,), (32 if platform.wide_sprites else 16,))
+    at_i = jax.lax.dynamic_slice(state.memory, (I + MEMORY_OFFSET,), (_bytes_at_i(platform),))
     at_i = at_i.astype(jnp.int32)
     window = at_i[:16]
     fields = decode(code[0], code[1], platform)
@@ -198,10 +198,11 @@ def execute(platform: Platform, quirks: Quirks, state: MachineState, keys: jax.A
     fetched = fetch(platform, quirks, state, keys, stalled)
     kind, c = fetched.kind, fetched.context
     # The memory write goes first and DXYN, the one handler that reads the collision, after it:
-    # its sprite is the bytes fetched at I before the write (16, or 32 after CHIP-8), and XO-CHIP's
-    # plane 2 is read from the written memory. DXYN writes no memory, so those are the same bytes,
-    # and XLA never has to copy the memory buffer to keep the old version alive (a read of the old
-    # memory after the write costs a whole 64 KiB copy per instruction on XO-CHIP, measured).
+    # its sprite is the bytes fetched at I before the write (16, 32 on SUPER-CHIP, 64 for XO-CHIP's
+    # two planes). DXYN writes no memory, so those are the bytes it would see after the write, and
+    # nothing reads memory after the write: XLA never has to copy the memory buffer to keep the old
+    # version alive (a read of the old memory after the write cost a whole 64 KiB copy per
+    # instruction on XO-CHIP, measured).
     effects = {k: handler(c) for k, handler in handlers(platform).items()}
     defaults = _defaults(state, c)
     before_drawing = merge(kind, effects, defaults)  # all but DXYN's VF, which needs the collision
@@ -210,7 +211,7 @@ def execute(platform: Platform, quirks: Quirks, state: MachineState, keys: jax.A
     # rare ones first (scrolls, hires clears), each straight on the state's surfaces.
     screen, grid = _scroll_and_clear_hires(platform, state, before_drawing, c)
     drawing = kind == Kind.DRW
-    grid, collision, mask = _draw(platform, quirks, screen, grid, written, fetched, drawing)
+    grid, collision, mask = _draw(platform, quirks, screen, grid, fetched, drawing)
     effects[Kind.DRW] = display.op_dxyn(c._replace(collision=collision))
     effect = merge(kind, effects, defaults)
     screen = _draw_lores(platform, screen, mask, effect, c)
@@ -238,18 +239,29 @@ def write_window(platform: Platform, memory, window, I):
     return jax.lax.dynamic_update_slice(memory, window, (other + MEMORY_OFFSET,))
 
 
-def _sprite_data(platform: Platform, memory, fetched: Fetched):
+def _bytes_at_i(platform: Platform) -> int:
+    """How many bytes `fetch` reads at I: CHIP-8's 16 (the window, a sprite of up to 15 rows),
+    a 16x16 sprite's 32 after it, and on two planes the 64 that hold both planes' sprites (plane
+    2's starts at most 32 bytes after plane 1's). The RAM mirror (`mirrored_bytes`) keeps each
+    read one contiguous slice."""
+    if not platform.wide_sprites:
+        return 16
+    return 32 * platform.planes
+
+
+def _sprite_data(platform: Platform, fetched: Fetched):
     """The bytes a sprite is drawn from: CHIP-8's (16,) at I (the window), or (planes, 32) after
-    it: plane 1's at I (read with the window), plane 2's after plane 1's rows when both planes are
-    drawn, else at I too, read from `memory`, the written one (see `execute`)."""
+    it: plane 1's at I, and plane 2's after plane 1's rows when both planes are drawn, else at I
+    too, all from the bytes `fetch` read at I. Those are the memory before this instruction's
+    write, which is the memory a draw sees: DXYN writes none (see `execute`)."""
     if not platform.extended:
         return fetched.at_i
-    first = fetched.at_i
+    first = fetched.at_i[:32]
     if platform.planes == 1:
         return first[None, :]
     c = fetched.context
     size = jnp.where(c.n == 0, 32, c.n) * (c.plane & 1)  # plane 1's bytes, when plane 1 is drawn
-    second = jax.lax.dynamic_slice(memory, (c.I + size + MEMORY_OFFSET,), (32,)).astype(jnp.int32)
+    second = jax.lax.dynamic_slice(fetched.at_i, (size,), (32,))
     return jnp.stack([first, second])
 
 
@@ -293,7 +305,7 @@ def _scroll_planes(surface, inputs):
 
 
 
-def _draw(platform: Platform, quirks: Quirks, screen, grid, memory, fetched: Fetched, drawing):
+def _draw(platform: Platform, quirks: Quirks, screen, grid, fetched: Fetched, drawing):
     """DXYN: (the grid with the hires sprite drawn, the collision, the XOR mask of the 64x32
     sprite: all zero for any other instruction, and for a machine in hires).
 
@@ -302,7 +314,7 @@ def _draw(platform: Platform, quirks: Quirks, screen, grid, memory, fetched: Fet
     under `when_any`, when some machine of the batch draws in hires.
     """
     c, n = fetched.context, fetched.fields.n
-    patterns, height = display.sprite_patterns(_sprite_data(platform, memory, fetched), n, platform.wide_sprites)
+    patterns, height = display.sprite_patterns(_sprite_data(platform, fetched), n, platform.wide_sprites)
     if not platform.extended:
         mask = display.sprite_mask(patterns, c.vx & 63, c.vy & 31, jnp.where(drawing, height, 0), display.LORES,
                                    quirks.clipping)
