@@ -54,12 +54,20 @@ def test_specs_are_complete():
         assert spec.quirks in ("chip8", "schip"), f"{game_id}: quirks {spec.quirks!r}"
 
 
-@pytest.mark.parametrize("game_id", EXPECTED_IDS)
+# make test runs the contract on one game of each ROM family and our games' middle levels; every
+# other id (levels of the same ROM, the rest of the suite) in make test-slow (6-10 s of compiles each).
+CONTRACT_IN_MAKE_TEST = {"Airplane", "Brix", "Cavern1", "Pong", "SpaceFlight1", "TargetShooter1", "Tetris", "Blinky",
+                         "Cycles", "Dodge", "Duel", "Flak"}
+
+
+@pytest.mark.parametrize("game_id", [g if g in CONTRACT_IN_MAKE_TEST else pytest.param(g, marks=pytest.mark.slow)
+                                     for g in EXPECTED_IDS])
 def test_contract(game_id, octax_rom_dir):
     check_env(game_id, num_envs=2, steps=3)
 
 
-@pytest.mark.parametrize("game_id", OTHER_LEVELS)
+@pytest.mark.parametrize("game_id", [g if g in ("Cavern2", "SpaceFlight2", "TargetShooter2")
+                                     else pytest.param(g, marks=pytest.mark.slow) for g in OTHER_LEVELS])
 def test_random_policy_gives_finite_rewards(game_id, octax_rom_dir):
     env, params = octax_core.make(game_id)
     num_envs, steps = 16, 1500

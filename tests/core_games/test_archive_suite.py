@@ -142,7 +142,7 @@ def test_every_programs_colours_parse():
         _rgb("mauve")
 
 
-@pytest.mark.parametrize("obs_scale", [1, 255])
+@pytest.mark.parametrize("obs_scale", [1, pytest.param(255, marks=pytest.mark.slow)])
 def test_contract_takes_xochip_plane_codes(obs_scale):
     """Civiliz8n's title lights both planes: codes 0..3 (x 85 at obs_scale 255), which the contract allows."""
     check_env("Civiliz8n", num_envs=2, steps=2, obs_scale=obs_scale)

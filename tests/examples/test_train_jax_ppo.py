@@ -93,6 +93,7 @@ def test_make_train_and_evaluate_check_autoreset(counter_rom):
         ppo.make_train(dataclasses.replace(TINY, num_minibatches=3), env, env_params)
 
 
+@pytest.mark.slow  # a whole main() run (25 s); the update and the config checks above run in make test
 def test_main_writes_csv_and_plot(tmp_path):
     summary = ppo.main(["--game", "Brix", "--num-envs", "4", "--num-steps", "8", "--num-minibatches", "2",
                         "--update-epochs", "1", "--total-steps", "64", "--eval-every", "32", "--eval-envs", "2",

@@ -99,6 +99,7 @@ def test_make_train_checks_autoreset(counter_rom):
         pqn.make_train(dataclasses.replace(config, num_seeds=0), env, env_params)
 
 
+@pytest.mark.slow  # a whole main() run (30 s); the update and the config checks above run in make test
 def test_main_writes_csv_and_plot_per_seed(tmp_path):
     summary = pqn.main(["--game", "Brix", "--num-envs", "4", "--num-steps", "8", "--num-minibatches", "2",
                         "--update-epochs", "1", "--total-steps", "64", "--eval-every", "32", "--eval-envs", "2",

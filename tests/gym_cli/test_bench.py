@@ -202,6 +202,7 @@ def test_env_loop_usage_errors():
     assert result.returncode == 2 and "--layers takes env, gym" in result.stderr
 
 
+@pytest.mark.slow  # three platforms' compiles (17 s); the same-program run above covers the three in make test
 def test_platforms_prints_one_line_per_platform_with_its_state_bytes(octax_rom_dir):
     result = subprocess.run(
         [sys.executable, "benchmarks/platforms.py", "--envs", "2", "--steps", "2", "--repeats", "1"],

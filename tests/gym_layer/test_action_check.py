@@ -52,6 +52,7 @@ def make_envs(counter_rom):
     return build
 
 
+@pytest.mark.slow  # 30 s of compiles; the host checks' tests above run in make test
 def test_jax_actions_are_never_read_on_the_step_path(make_envs, monkeypatch):
     envs = make_envs("jax")
     envs.reset(seed=0)
