@@ -254,13 +254,18 @@ def finish_dataset(dataset) -> bool:
 def update_metadata(data_path: Path, changes: dict[str, Any]) -> None:
     """metadata.json with `changes`, written whole under a temporary name and renamed into place
     (Minari's own update rewrites the file in place, which a kill can leave half-written)."""
-    from minari.dataset.minari_storage import _json_converter
-
     path = Path(data_path) / METADATA
     metadata = json.loads(path.read_text())
     metadata.update(changes)
     with _replacing(path) as tmp:
-        tmp.write_text(json.dumps(metadata, default=_json_converter))
+        tmp.write_text(json.dumps(metadata, default=_json_value))
+
+
+def _json_value(value):
+    """What metadata.json holds for a set (Minari's author and author_email): a list, as Minari writes it."""
+    if isinstance(value, set):
+        return sorted(value)
+    raise TypeError(f"metadata value of type {type(value).__name__} is not JSON serializable")
 
 
 def data_size(data_path: Path) -> float:
