@@ -27,6 +27,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
+from octax_core.emulator.gate import when_any
 from octax_core.emulator.machine import Machine
 from octax_core.emulator.state import (MachineState, screen_values, shown, screen_values_max, screen_values_shape,
                                        unpack_screen)
@@ -166,9 +167,17 @@ class Env:
     def autoreset(self, key: jax.Array, mask, obs: jax.Array, state: EnvState, params: EnvParams):
         """Where `mask` (bool scalar) holds, a new episode (`reset_env(key)`); else `obs`, `state`.
 
-        Both are computed and one is selected (under `vmap` there is no real branching), which
-        costs a draw from the start pool and a select whatever `noop_max` is.
+        Under `vmap` there is no real branching: a new episode is drawn for every env and
+        selected where its episode ended, a draw from the start pool and a select over the whole
+        state and observation, whatever `noop_max` is. So it runs under `gate.when_any`: on a
+        step where no env of the batch ended (most steps: episodes last hundreds of steps) none of
+        it runs, and where `mask` is false the select gives `obs` and `state` back bit for bit.
         """
+        return when_any(mask, self._restart_where, (obs, state), (key, mask, params))
+
+    def _restart_where(self, operands, inputs):
+        """`autoreset`'s work for one env: a new episode, selected where `mask` holds."""
+        (obs, state), (key, mask, params) = operands, inputs
         fresh = self.reset_env(key, params)
         return jax.tree.map(lambda new, old: jnp.where(mask, new, old), fresh, (obs, state))
 

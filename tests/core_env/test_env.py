@@ -106,6 +106,32 @@ def test_same_step_autoreset(counter):
     assert rows == [(4.0, False, False, 1, 4.0)]
 
 
+def test_batched_autoreset_is_the_select_it_gates(counter):
+    """`Env.autoreset` runs under `gate.when_any`: over a batch it must equal the plain select
+    (a new episode where the mask holds) whether no env, some or all ended, bit for bit."""
+    env, params, _, _ = counter(noop_max=3)
+    keys = jax.random.split(jax.random.key(4), 6)
+    obs, state = jax.vmap(env.reset, in_axes=(0, None))(keys, params)
+    steps = jax.vmap(env.step, in_axes=(0, 0, 0, None))
+    obs, state, *_ = steps(keys, state, jax.numpy.array([1, 2, 0, 3, 1, 2]), params)
+    gated = jax.jit(jax.vmap(env.autoreset, in_axes=(0, 0, 0, 0, None)))
+
+    def plain(key, mask, obs, state):
+        fresh = env.reset_env(key, params)
+        return jax.tree.map(lambda new, old: jax.numpy.where(mask, new, old), fresh, (obs, state))
+
+    new_keys = jax.random.split(jax.random.key(9), 6)
+    for mask in ([False] * 6, [False, True, False, False, True, False], [True] * 6):
+        mask = jax.numpy.array(mask)
+        got = gated(new_keys, mask, obs, state, params)
+        want = jax.vmap(plain)(new_keys, mask, obs, state)
+        for a, b in zip(jax.tree.leaves(got), jax.tree.leaves(want)):
+            if jax.numpy.issubdtype(a.dtype, jax.dtypes.prng_key):
+                a, b = jax.random.key_data(a), jax.random.key_data(b)
+            np.testing.assert_array_equal(np.asarray(a), np.asarray(b))
+    assert not np.array_equal(np.asarray(want[1].episode_step), np.asarray(state.episode_step))  # some were reset
+
+
 def test_observation_holds_each_frame_and_its_scale(counter):
     for scale in (1, 255):
         env, params, reset, step = counter(obs_scale=scale)
