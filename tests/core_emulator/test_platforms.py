@@ -19,6 +19,7 @@ from reference import BIG_FONT, RefMachine, assemble, first_difference
 import octax_core
 from octax_core.emulator.platforms import PLATFORMS
 from octax_core.emulator.quirks import quirks_from_octo
+from octax_core.emulator.state import shown
 
 START = 0x200
 ARROW = bytes([0x18, 0x3C, 0x7E, 0xFF, 0x18, 0x18, 0x18, 0x18])
@@ -232,6 +233,32 @@ def test_record_screens_has_the_platform_shape(jit_run_frames):
     machine = octax_core.Machine("schip")
     state, screens = machine.run_frames(machine.boot(b"\x12\x00", jax.random.key(0)), 0, 3, record_screens=True)
     assert screens.shape == (3, 1, 64, 4) and screens.dtype == jnp.uint32
+
+
+def test_recorded_screens_are_each_frames_picture_through_an_exit_and_a_halt():
+    # One recorded call of 5 frames equals 5 one-frame calls, picture by picture, for a batch of
+    # a machine that exits in its fourth frame (key A held: the frames after show its last
+    # picture), one that runs on drawing (no key), and one halted (all five show its picture).
+    rom = assemble(0x6A0A, 0xA212, 0x7004, 0xD011, 0xEA9E, 0x1204, 0x4010, 0x00FD, 0x1204) + b"\x80"
+    machine = octax_core.Machine("schip", instructions_per_frame=5)
+    keys = jnp.array([1 << 0xA, 0, 0], jnp.uint32)
+    halted = jnp.array([False, False, True])
+    boot = jax.vmap(lambda k: machine.boot(rom, k))(jax.random.split(jax.random.key(3), 3))
+    boot = jax.jit(jax.vmap(lambda s, k: machine.run_frames(s, k, 1)))(boot, jnp.array([0, 0, 1 << 0xA], jnp.uint32))
+    state, screens = jax.jit(jax.vmap(lambda s, k, h: machine.run_frames(s, k, 5, halted=h, record_screens=True)))(
+        boot, keys, halted)
+    one = jax.jit(lambda s, k, h: machine.run_frames(s, k, 1, halted=h))
+    for i in range(3):
+        alone = jax.tree.map(lambda leaf: leaf[i], boot)
+        for frame in range(5):
+            alone = one(alone, keys[i], halted[i])
+            assert np.array_equal(np.asarray(screens[i, frame]), np.asarray(shown(alone))), (i, frame)
+        assert bool(alone.exited) == (i == 0)
+        assert all(np.array_equal(np.asarray(a), np.asarray(b)[i])
+                   for a, b in zip(jax.tree.leaves(alone), jax.tree.leaves(state)))
+    assert not np.array_equal(np.asarray(screens[0, 1]), np.asarray(screens[0, 2]))  # it drew on its way
+    assert np.array_equal(np.asarray(screens[0, 3]), np.asarray(screens[0, 4]))
+    assert np.asarray(screens[2]).any()  # the halted machine's picture is not blank
 
 
 # ---- Octo's option flags ----------------------------------------------------------------------------
