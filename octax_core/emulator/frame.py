@@ -76,9 +76,12 @@ def _start(loop: Loop, state, halted, profile) -> Clock:
     still = halted | state.exited
     zero = jnp.zeros_like(state.pc, dtype=jnp.int32)
     picture = shown(state)
-    # Every row starts as the picture now: what a machine that runs no frame (halted, exited)
-    # shows in all of them. The frames that do run overwrite theirs.
-    screens = jnp.broadcast_to(picture[None], (loop.frames if loop.record_screens else 1, *picture.shape))
+    if loop.record_screens:
+        # Every row starts as the picture now: what a machine that runs no frame (halted, exited)
+        # shows in all of them. The frames that do run overwrite theirs.
+        screens = jnp.broadcast_to(picture[None], (loop.frames, *picture.shape))
+    else:
+        screens = jnp.zeros((1, *picture.shape), picture.dtype)  # a dummy: nothing is recorded
     return Clock(frame=jnp.where(still, loop.frames, 0).astype(jnp.int32), count=zero,
                  target=zero + instructions_per_frame, detector=idle.start(state, loop.skip_idle),
                  screens=screens)
