@@ -8,9 +8,10 @@ Every handler runs on every instruction (under `vmap` there is no real branching
 return small effects and `execute` merges them field by field with scalar selects on the decoded
 kind, then applies the merged effect once. Whatever the opcode, an instruction costs two
 contiguous memory reads (the opcode, 16 bytes at I), one 16-byte window write (two, to keep the
-mirror), a sprite drawn on the 64x32 surface, and a few lane selects on the registers and the
-stack. The work few machines need on a given instruction (a hires sprite, a hires clear, a
-scroll) runs under `gate.when_any`: the whole batch skips it when no machine needs it.
+mirror), a sprite drawn on plane 1 of the 64x32 surface, and a few lane selects on the
+registers and the stack. The work few machines need on a given instruction (a hires sprite, a
+sprite on XO-CHIP's second plane, a hires clear, a scroll) runs under `gate.when_any`: the whole
+batch skips it when no machine needs it.
 """
 
 from __future__ import annotations
@@ -139,7 +140,8 @@ def merge(kind, effects: dict, defaults: Effect) -> Effect:
     """One effect: each field the value of the handler `kind` selects, where that handler sets
     it, else the field of `defaults`. No branching: a scalar field is a chain of scalar selects;
     a vector field (16 registers or bytes) one lookup in the stack of its candidates, since a
-    chain of whole-vector selects costs 16 times as much per link."""
+    chain of whole-vector selects costs 16 times as much per link, or one select where a single
+    handler sets it (the stack and its lookup cost more than that select)."""
     merged = {}
     for field, default in zip(Effect._fields, defaults):
         if default is None:  # a field this platform does not have (SUPER-CHIP's, on CHIP-8)
@@ -150,6 +152,9 @@ def merge(kind, effects: dict, defaults: Effect) -> Effect:
             value = default
             for handler_kind, candidate in setters:
                 value = jnp.where(kind == handler_kind, candidate, value)
+        elif len(setters) == 1:  # one handler sets it (FX75's flags, F002's pattern): one select
+            (handler_kind, candidate), = setters
+            value = jnp.where(kind == handler_kind, jnp.asarray(candidate, default.dtype), default)
         else:
             row = np.zeros(len(Kind), np.int32)  # kind -> its row in the stack; 0: the default
             row[[int(k) for k, _ in setters]] = np.arange(1, len(setters) + 1)
@@ -211,10 +216,9 @@ def execute(platform: Platform, quirks: Quirks, state: MachineState, keys: jax.A
     # rare ones first (scrolls, hires clears), each straight on the state's surfaces.
     screen, grid = _scroll_and_clear_hires(platform, state, before_drawing, c)
     drawing = kind == Kind.DRW
-    grid, collision, mask = _draw(platform, quirks, screen, grid, fetched, drawing)
+    screen, grid, collision = _draw(platform, quirks, screen, grid, fetched, drawing, before_drawing)
     effects[Kind.DRW] = display.op_dxyn(c._replace(collision=collision))
     effect = merge(kind, effects, defaults)
-    screen = _draw_lores(platform, screen, mask, effect, c)
     return _apply(platform, state, kind, effects, effect, written, screen, grid, c), kind
 
 
@@ -249,29 +253,34 @@ def _bytes_at_i(platform: Platform) -> int:
     return 32 * platform.planes
 
 
-def _sprite_data(platform: Platform, fetched: Fetched):
-    """The bytes a sprite is drawn from: CHIP-8's (16,) at I (the window), or (planes, 32) after
-    it: plane 1's at I, and plane 2's after plane 1's rows when both planes are drawn, else at I
-    too, all from the bytes `fetch` read at I. Those are the memory before this instruction's
-    write, which is the memory a draw sees: DXYN writes none (see `execute`)."""
-    if not platform.extended:
-        return fetched.at_i
-    first = fetched.at_i[:32]
-    if platform.planes == 1:
-        return first[None, :]
-    c = fetched.context
-    size = jnp.where(c.n == 0, 32, c.n) * (c.plane & 1)  # plane 1's bytes, when plane 1 is drawn
-    second = jax.lax.dynamic_slice(fetched.at_i, (size,), (32,))
-    return jnp.stack([first, second])
-
-
 class _Sprite(NamedTuple):
-    """What a hires draw reads (see `_draw_hires`)."""
+    """What a gated draw reads (`_draw_hires`, `_draw_second_plane`): the bytes fetched at I, the
+    opcode's N, the planes the machine draws this sprite on (bits; 0 where it draws nothing on
+    that surface, which makes the draw a no-op), and where."""
 
-    patterns: jax.Array  # (planes, 16) uint32, zero on planes not drawn and on machines not in hires
+    at_i: jax.Array  # (32 * planes,) int32
+    n: jax.Array
+    planes: jax.Array  # int32 bits: plane 1 = 1, plane 2 = 2
     x: jax.Array
     y: jax.Array
-    height: jax.Array
+
+
+def _plane_data(sprite: _Sprite, plane: int):
+    """The 32 bytes plane `plane` (0 or 1) draws from: plane 1's at I, plane 2's after plane 1's
+    rows when both are drawn, else at I too. They are the memory before this instruction's write,
+    which is the memory a draw sees: DXYN writes none (see `execute`)."""
+    if plane == 0:
+        return sprite.at_i[:32]
+    size = jnp.where(sprite.n == 0, 32, sprite.n) * (sprite.planes & 1)  # plane 1's bytes, when it is drawn
+    return jax.lax.dynamic_slice(sprite.at_i, (size,), (32,))
+
+
+def _plane_patterns(sprite: _Sprite, planes: range):
+    """((len(planes), 16) uint32 rows, zero on the planes the sprite is not drawn on; height)."""
+    data = jnp.stack([_plane_data(sprite, plane) for plane in planes])
+    patterns, height = display.sprite_patterns(data, sprite.n, True)
+    drawn = ((sprite.planes >> jnp.asarray(list(planes), jnp.int32)) & 1) == 1
+    return jnp.where(drawn[:, None], patterns, jnp.uint32(0)), height
 
 
 def _scroll_and_clear_hires(platform: Platform, state: MachineState, effect: Effect, c: Context):
@@ -305,40 +314,62 @@ def _scroll_planes(surface, inputs):
 
 
 
-def _draw(platform: Platform, quirks: Quirks, screen, grid, fetched: Fetched, drawing):
-    """DXYN: (the grid with the hires sprite drawn, the collision, the XOR mask of the 64x32
-    sprite: all zero for any other instruction, and for a machine in hires).
+def _draw(platform: Platform, quirks: Quirks, screen, grid, fetched: Fetched, drawing, effect: Effect):
+    """DXYN, and the merged effect's lores clear: (the 64x32 screen, the grid, the collision).
 
     The 64x32 surface (CHIP-8's screen; the lores screen of SUPER-CHIP and XO-CHIP) is drawn by
-    every machine (`_draw_lores`, a zero mask where it does not draw); the 128x64 grid only
-    under `when_any`, when some machine of the batch draws in hires.
+    every machine on plane 1 (a zero mask where it does not draw); XO-CHIP's plane 2 there, and
+    the 128x64 grid, only under `when_any`, when some machine of the batch draws on them: a
+    CHIP-8 program run by XO-CHIP never pays for the second plane, nor one in lores for hires.
     """
     c, n = fetched.context, fetched.fields.n
-    patterns, height = display.sprite_patterns(_sprite_data(platform, fetched), n, platform.wide_sprites)
     if not platform.extended:
+        patterns, height = display.sprite_patterns(fetched.at_i, n, False)
         mask = display.sprite_mask(patterns, c.vx & 63, c.vy & 31, jnp.where(drawing, height, 0), display.LORES,
                                    quirks.clipping)
-        return None, display.collides(screen, mask), mask
-    selected = ((c.plane >> jnp.arange(platform.planes, dtype=jnp.int32)) & 1) == 1
-    patterns = jnp.where(selected[:, None] & drawing, patterns, jnp.uint32(0))
-    lores = jnp.where(c.hires, jnp.uint32(0), patterns)
-    mask = display.sprite_mask(lores, c.vx & 63, c.vy & 31, height, display.LORES, quirks.clipping)
-    lores_collision = display.collides(screen, mask)
-    sprite = _Sprite(jnp.where(c.hires, patterns, jnp.uint32(0)), c.vx & 127, c.vy & 63, height)
+        return _draw_lores(platform, screen, mask, effect, c), None, display.collides(screen, mask)
+    drawn = jnp.where(drawing, c.plane, 0)
+    lores = _Sprite(fetched.at_i, n, jnp.where(c.hires, 0, drawn), c.vx & 63, c.vy & 31)
+    patterns, height = _plane_patterns(lores, range(1))
+    mask = display.sprite_mask(patterns, lores.x, lores.y, height, display.LORES, quirks.clipping)
+    collision = display.collides(screen[:1], mask)
+    if platform.planes > 1:  # plane 2's mask is zero here: `_draw_second_plane` draws it
+        mask = jnp.concatenate([mask, jnp.zeros_like(mask)])
+    screen = _draw_lores(platform, screen, mask, effect, c)
     # `when_any`'s work may close over constants only: a mix's per-machine clipping is an input
     fixed = isinstance(quirks.clipping, bool)
-    grid, hires_collision = when_any(drawing & c.hires, _draw_hires(quirks.clipping if fixed else None),
-                                     (grid, jnp.bool_(False)), (sprite, None if fixed else quirks.clipping))
-    return grid, jnp.where(c.hires, hires_collision, lores_collision), mask
+    clipping = quirks.clipping if fixed else None
+    own_clipping = None if fixed else quirks.clipping
+    if platform.planes > 1:
+        screen, collision = when_any((lores.planes & 2) != 0, _draw_second_plane(clipping), (screen, collision),
+                                     (lores, own_clipping))
+    hires = _Sprite(fetched.at_i, n, jnp.where(c.hires, drawn, 0), c.vx & 127, c.vy & 63)
+    grid, hires_collision = when_any(hires.planes != 0, _draw_hires(platform, clipping), (grid, jnp.bool_(False)),
+                                     (hires, own_clipping))
+    return screen, grid, jnp.where(c.hires, hires_collision, collision)
 
 
-def _draw_hires(clipping):
-    """The hires draw under `when_any`: `clipping` a constant, or None to read the machine's own
-    from the inputs (a mix of profiles)."""
+def _draw_second_plane(clipping):
+    """XO-CHIP's plane 2 drawn on the 64x32 screen, under `when_any`: the collision of plane 1's
+    draw or of this one. `clipping` a constant, or None to read the machine's own from the inputs
+    (a mix of profiles)."""
+    def draw(operands, inputs):
+        (screen, collision), (sprite, own_clipping) = operands, inputs
+        patterns, height = _plane_patterns(sprite, range(1, 2))
+        mask = display.sprite_mask(patterns, sprite.x, sprite.y, height, display.LORES,
+                                   clipping if own_clipping is None else own_clipping)
+        return screen ^ jnp.concatenate([jnp.zeros_like(mask), mask]), collision | display.collides(screen[1:], mask)
+    return draw
+
+
+def _draw_hires(platform: Platform, clipping):
+    """The hires draw under `when_any`, every plane: `clipping` a constant, or None to read the
+    machine's own from the inputs (a mix of profiles)."""
     def draw(operands, inputs):
         (grid, _), (sprite, own_clipping) = operands, inputs
-        clip = clipping if own_clipping is None else own_clipping
-        mask = display.sprite_mask(sprite.patterns, sprite.x, sprite.y, sprite.height, display.HIRES, clip)
+        patterns, height = _plane_patterns(sprite, range(platform.planes))
+        mask = display.sprite_mask(patterns, sprite.x, sprite.y, height, display.HIRES,
+                                   clipping if own_clipping is None else own_clipping)
         return grid ^ mask, display.collides(grid, mask)
     return draw
 

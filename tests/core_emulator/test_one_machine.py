@@ -127,6 +127,43 @@ def test_one_chip8_program_runs_alike_on_every_platform(pong_runs):
         assert not np.asarray(state.extension.grid).any() and not np.asarray(state.extension.hires).any()
 
 
+def _xochip_drawing(planes: int, hires: bool) -> bytes:
+    """An XO-CHIP program: select `planes`, draw a 5-row sprite (two, one per plane, when both are
+    selected) three times at (5, 3), keeping VF after the second draw in V2 and after the third in
+    V3, then spin."""
+    words = [0x00FF] if hires else []
+    words += [0xF001 | planes << 8, 0xA220, 0x6005, 0x6103, 0xD015, 0xD015, 0x82F0, 0xD015, 0x83F0]
+    code = b"".join(w.to_bytes(2, "big") for w in words)
+    code += (0x1200 + len(code)).to_bytes(2, "big")  # jump to self
+    sprite = bytes([0xF0, 0x90, 0x90, 0x90, 0xF0]) + bytes([0xFF, 0x81, 0x81, 0x81, 0xFF])
+    return code.ljust(0x20, b"\0") + sprite
+
+
+def test_plane_2_is_drawn_where_a_machine_asks_in_any_batch():
+    """XO-CHIP's plane 2 on the 64x32 screen is gated work (`cpu._draw_second_plane`): in a batch
+    where machines draw on plane 1, plane 2, both, none, or in hires, each machine's screen, grid
+    and collisions are its own run alone, and a batch where no machine asks leaves plane 2 dark."""
+    machine = octax_core.Machine("xochip", instructions_per_frame=30)
+    cases = [(1, False), (2, False), (3, False), (0, False), (3, True), (2, True)]
+    states = [machine.boot(_xochip_drawing(planes, hires), jax.random.key(i)) for i, (planes, hires) in enumerate(cases)]
+    alone = [jax.jit(machine.run_frames, static_argnums=2)(state, 0, 1) for state in states]
+    batch = jax.tree.map(lambda *leaves: jnp.stack(leaves), *states)
+    run = jax.jit(jax.vmap(lambda s: machine.run_frames(s, 0, 1)))
+    together = run(batch)
+    for m, ((planes, hires), one) in enumerate(zip(cases, alone)):
+        for path, leaf, expected in zip(jax.tree_util.tree_flatten_with_path(one)[0], jax.tree.leaves(together),
+                                        jax.tree.leaves(one)):
+            if jnp.issubdtype(leaf.dtype, jax.dtypes.prng_key):
+                leaf, expected = jax.random.key_data(leaf), jax.random.key_data(expected)
+            np.testing.assert_array_equal(np.asarray(leaf)[m], np.asarray(expected), err_msg=f"{m} {path[0]}")
+        V = np.asarray(one.V)
+        assert (V[2], V[3]) == ((1, 0) if planes else (0, 0)), (planes, hires)  # the second draw erased
+        surface = np.asarray(one.extension.grid if hires else one.screen)
+        assert [bool(surface[p].any()) for p in range(2)] == [bool(planes & 1), bool(planes & 2)]
+    plane_1_only = jax.tree.map(lambda leaf: leaf[np.array([0, 3, 0, 3])], batch)
+    assert not np.asarray(run(plane_1_only).screen)[:, 1].any()
+
+
 def test_the_frame_loop_is_the_only_loop():
     """Every path of `Machine.run_frames` goes through `frame.frame_runner` (skipping or not,
     recording or not); the executor is `cpu.execute` for every platform."""
