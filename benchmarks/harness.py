@@ -181,7 +181,8 @@ def machine_line(rom: Path) -> str:
     import jax
 
     return (f"# jax {jax.__version__} backend={jax.default_backend()} devices={jax.device_count()} "
-            f"python {platform.python_version()} cpus={os.cpu_count()} rom={rom.name}")
+            f"python {platform.python_version()} cpus={os.cpu_count()} "
+            f"xla_cpu_threads={os.environ.get('OCTAX_CPU_THREADS') or 'default'} rom={rom.name}")
 
 
 def load_average() -> float:

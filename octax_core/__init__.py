@@ -8,20 +8,28 @@ Three layers, each a subpackage that imports only the ones before it:
 * `octax_core.tools`: the Octo assembler and disassembler, and the register tracer.
 
 The names below are the public API. See docs/machine.md (the machine) and docs/env.md (the envs).
+``OCTAX_CPU_THREADS`` (read here, before anything else starts JAX) sizes XLA:CPU's thread pool;
+see `octax_core.host`.
 """
+
+from octax_core import host
+
+host.apply_environment()  # before any import below can start JAX's backends
+
 
 from octax_core.emulator import (FONT, FONT_ADDRESS, MAX_ROM_SIZE, PLATFORMS, PROGRAM_ADDRESS, QUIRK_PROFILES, Kind,
                                  Machine, MachineState, Platform, Quirks, Rom, poke, render_text, snapshot)
 from octax_core.env import (Env, EnvConfig, EnvParams, EnvState, GameSpec, MixEnv, MultiEnv, Seats, get_spec, list_games,
                             make, make_config, make_mix, make_multi, make_params)
 from octax_core.env.testing import check_env
+from octax_core.host import limit_cpu_threads
 from octax_core.tools.octo import AssemblyError, assemble
 
 __all__ = [
     "AssemblyError", "FONT", "FONT_ADDRESS", "Env", "EnvConfig", "EnvParams", "EnvState", "GameSpec", "Kind",
     "MAX_ROM_SIZE", "Machine", "MachineState", "MixEnv", "MultiEnv", "Seats", "PLATFORMS", "PROGRAM_ADDRESS", "Platform", "QUIRK_PROFILES",
     "Quirks", "Rom",
-    "assemble", "check_env", "disassemble", "get_spec", "list_games", "make", "make_config", "make_mix", "make_multi", "make_params", "poke",
+    "assemble", "check_env", "disassemble", "get_spec", "limit_cpu_threads", "list_games", "make", "make_config", "make_mix", "make_multi", "make_params", "poke",
     "render_text", "snapshot",
 ]
 
