@@ -16,14 +16,14 @@ batch skips it when no machine needs it.
 
 from __future__ import annotations
 
-from typing import NamedTuple
+from typing import NamedTuple, Optional
 
 import jax
 import jax.numpy as jnp
 import numpy as np
 
 from octax_core.emulator.decode import Decoded, decode
-from octax_core.emulator.gate import when_any
+from octax_core.emulator.gate import any_of_batch, when_any
 from octax_core.emulator.opcodes import LEVELS, OPCODES, Kind
 from octax_core.emulator.ops import Context, Effect, alu, display, extended, flow, keys, memory, timers
 from octax_core.emulator.platforms import Platform
@@ -214,9 +214,10 @@ def execute(platform: Platform, quirks: Quirks, state: MachineState, keys: jax.A
     written = _write_memory(platform, state.memory, before_drawing, c)
     # An instruction draws, clears or scrolls, never two of these, so their order is free: the
     # rare ones first (scrolls, hires clears), each straight on the state's surfaces.
-    screen, grid = _scroll_and_clear_hires(platform, state, before_drawing, c)
     drawing = kind == Kind.DRW
-    screen, grid, collision = _draw(platform, quirks, screen, grid, fetched, drawing, before_drawing)
+    needs = _needs(platform, c, before_drawing, drawing)
+    screen, grid = _scroll_and_clear_hires(platform, state, before_drawing, c, needs)
+    screen, grid, collision = _draw(platform, quirks, screen, grid, fetched, drawing, before_drawing, needs)
     effects[Kind.DRW] = display.op_dxyn(c._replace(collision=collision))
     effect = merge(kind, effects, defaults)
     return _apply(platform, state, kind, effects, effect, written, screen, grid, c), kind
@@ -283,7 +284,28 @@ def _plane_patterns(sprite: _Sprite, planes: range):
     return jnp.where(drawn[:, None], patterns, jnp.uint32(0)), height
 
 
-def _scroll_and_clear_hires(platform: Platform, state: MachineState, effect: Effect, c: Context):
+class _Needs(NamedTuple):
+    """Whether some machine of the batch needs each gated work of this instruction (`_needs`)."""
+
+    grid_change: jax.Array  # a hires scroll or clear
+    screen_scroll: jax.Array  # a lores scroll
+    second_plane: jax.Array  # a lores sprite on XO-CHIP's plane 2
+    hires_sprite: jax.Array  # a sprite on the grid
+
+
+def _needs(platform: Platform, c: Context, effect: Effect, drawing) -> Optional[_Needs]:
+    """Each gate's predicate, reduced over the batch at once (`gate.any_of_batch`). None on
+    CHIP-8, which has no gated work."""
+    if not platform.extended:
+        return None
+    moving = (effect.scroll_x != 0) | (effect.scroll_y != 0)
+    drawn = jnp.where(drawing, c.plane, 0)
+    second = ~c.hires & ((drawn & 2) != 0) if platform.planes > 1 else jnp.bool_(False)
+    return _Needs(*any_of_batch(c.hires & ((effect.clear_planes != 0) | moving), ~c.hires & moving, second,
+                                c.hires & (drawn != 0)))
+
+
+def _scroll_and_clear_hires(platform: Platform, state: MachineState, effect: Effect, c: Context, needs):
     """The (screen, grid) after a scroll of the selected planes (of the 64x32 screen in lores, of
     the grid in hires) or a hires clear, under `when_any`: most instructions of most batches
     have neither. CHIP-8 has neither."""
@@ -297,9 +319,9 @@ def _scroll_and_clear_hires(platform: Platform, state: MachineState, effect: Eff
     def amounts(mode):  # a scroll moves the surface of the machine's mode; the other one stays
         return jnp.where(mode, effect.scroll_x, 0), jnp.where(mode, effect.scroll_y, 0)
 
-    grid = when_any(c.hires & ((effect.clear_planes != 0) | moving), _scroll_planes, state.extension.grid,
+    grid = when_any(needs.grid_change, _scroll_planes, state.extension.grid,
                     (cleared & c.hires, selected, *amounts(c.hires)))
-    screen = when_any(~c.hires & moving, _scroll_planes, state.screen,
+    screen = when_any(needs.screen_scroll, _scroll_planes, state.screen,
                       (jnp.zeros_like(cleared), selected, *amounts(~c.hires)))
     return screen, grid
 
@@ -314,7 +336,7 @@ def _scroll_planes(surface, inputs):
 
 
 
-def _draw(platform: Platform, quirks: Quirks, screen, grid, fetched: Fetched, drawing, effect: Effect):
+def _draw(platform: Platform, quirks: Quirks, screen, grid, fetched: Fetched, drawing, effect: Effect, needs):
     """DXYN, and the merged effect's lores clear: (the 64x32 screen, the grid, the collision).
 
     The 64x32 surface (CHIP-8's screen; the lores screen of SUPER-CHIP and XO-CHIP) is drawn by
@@ -341,10 +363,10 @@ def _draw(platform: Platform, quirks: Quirks, screen, grid, fetched: Fetched, dr
     clipping = quirks.clipping if fixed else None
     own_clipping = None if fixed else quirks.clipping
     if platform.planes > 1:
-        screen, collision = when_any((lores.planes & 2) != 0, _draw_second_plane(clipping), (screen, collision),
+        screen, collision = when_any(needs.second_plane, _draw_second_plane(clipping), (screen, collision),
                                      (lores, own_clipping))
     hires = _Sprite(fetched.at_i, n, jnp.where(c.hires, drawn, 0), c.vx & 127, c.vy & 63)
-    grid, hires_collision = when_any(hires.planes != 0, _draw_hires(platform, clipping), (grid, jnp.bool_(False)),
+    grid, hires_collision = when_any(needs.hires_sprite, _draw_hires(platform, clipping), (grid, jnp.bool_(False)),
                                      (hires, own_clipping))
     return screen, grid, jnp.where(c.hires, hires_collision, collision)
 

@@ -58,6 +58,37 @@ def when_any(pred: jax.Array, fn: Callable[[T, object], T], operands: T, inputs=
     return gated(pred, operands, inputs)
 
 
+def any_of_batch(*preds: jax.Array) -> tuple[jax.Array, ...]:
+    """For each per-machine predicate, whether it holds for some machine of the batch: one
+    reduction for them all, where a `when_any` per predicate reduces its own (each reduction is
+    a few XLA kernels, paid on every instruction). One machine alone gets its predicates back.
+
+    A `when_any` given the result runs its work for the whole batch when some machine needs it,
+    as with the per-machine predicate: the contract (a no-op for a machine that does not need
+    it) is what keeps that exact."""
+
+    @jax.custom_batching.custom_vmap
+    def each(preds):
+        return preds
+
+    @each.def_vmap
+    def each_batched(axis_size, in_batched, preds):
+        (batched,) = in_batched
+        columns = [jnp.broadcast_to(p, (axis_size,)) if b else None for p, b in zip(preds, batched)]
+        stacked = jnp.stack([c for c in columns if c is not None], axis=1) if any(batched) else None
+        anyone = jnp.any(stacked, axis=0) if stacked is not None else None
+        out, k = [], 0
+        for p, b in zip(preds, batched):
+            if b:
+                out.append(anyone[k])
+                k += 1
+            else:
+                out.append(p)
+        return tuple(out), tuple(False for _ in preds)
+
+    return each(tuple(jnp.asarray(p, jnp.bool_) for p in preds))
+
+
 def _per_platform(pred, fn, operands, inputs):
     """The loop of `_at_most_once` on `LOOPED_PLATFORMS`, `fn` unconditionally elsewhere."""
     def always(pred, operands, inputs):

@@ -8,7 +8,7 @@ import pytest
 
 import octax_core
 from octax_core.emulator import cpu, frame
-from octax_core.emulator.gate import when_any
+from octax_core.emulator.gate import any_of_batch, when_any
 from octax_core.emulator.ops import display
 from octax_core.emulator.state import shown
 
@@ -54,6 +54,26 @@ def test_when_any_unbatched_and_nested():
     # an unbatched predicate over a batch: the whole batch, or nobody
     shared = jax.jit(jax.vmap(lambda x, pred: when_any(pred, _add_where, x, (pred, jnp.int32(5))), in_axes=(0, None)))
     np.testing.assert_array_equal(shared(jnp.ones(3, jnp.int32), True), [6, 6, 6])
+
+
+def test_any_of_batch_reduces_every_predicate_at_once():
+    """Each predicate's answer for the whole batch, from one reduction; a predicate the batch
+    shares is its own answer; one machine alone gets its predicates back. A `when_any` fed the
+    answer runs its work for the whole batch exactly when some machine needs it."""
+    a = jnp.array([False, True, False, False])
+    b = jnp.zeros(4, bool)
+    batched = jax.jit(jax.vmap(lambda p, q, r: any_of_batch(p, q, r), in_axes=(0, 0, None)))
+    assert [bool(x) for x in batched(a, b, True)] == [True, False, True]
+    assert [bool(x) for x in jax.jit(any_of_batch)(True, False)] == [True, False]
+
+    def gated(pred, x):
+        (anyone,) = any_of_batch(pred)
+        return when_any(anyone, _add_where, x, (pred, jnp.int32(7)))
+
+    run = jax.jit(jax.vmap(gated))
+    x = jnp.arange(4, dtype=jnp.int32)
+    np.testing.assert_array_equal(run(a, x), np.where(a, x + 7, x))
+    np.testing.assert_array_equal(run(b, x), x)
 
 
 def test_upscale_doubles_every_pixel():
