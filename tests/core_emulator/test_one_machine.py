@@ -62,7 +62,7 @@ def test_any_of_batch_reduces_every_predicate_at_once():
     answer runs its work for the whole batch exactly when some machine needs it."""
     a = jnp.array([False, True, False, False])
     b = jnp.zeros(4, bool)
-    batched = jax.jit(jax.vmap(lambda p, q, r: any_of_batch(p, q, r), in_axes=(0, 0, None)))
+    batched = jax.jit(jax.vmap(lambda p, q, r: any_of_batch(p, q, r), in_axes=(0, 0, None), out_axes=None))
     assert [bool(x) for x in batched(a, b, True)] == [True, False, True]
     assert [bool(x) for x in jax.jit(any_of_batch)(True, False)] == [True, False]
 
