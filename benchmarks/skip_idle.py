@@ -25,6 +25,7 @@ import argparse
 import functools
 import json
 import math
+import os
 import platform
 import sys
 import time
@@ -170,7 +171,8 @@ def markdown(rows: list[dict]) -> str:
         *[f"    {command}" for command in dict.fromkeys(r.get("command", "(command not recorded)") for r in rows)],
         "",
         f"Machine: {platform.processor() or platform.machine()}, {_cores()} cores, CPU only; "
-        f"JAX {_jax_version()}. Env steps per second (4 frames a step, random actions, same-step autoreset), "
+        f"JAX {_jax_version()}; XLA:CPU's thread pool as each command gives it (JAX's default: a thread a core). "
+        "Env steps per second (4 frames a step, random actions, same-step autoreset), "
         "best of the timed runs; `exact`: every step's observation, reward and flags, and the final state, "
         "equal with and without skip_idle. docs/machine.md says what skip_idle detects.",
         "",
@@ -230,7 +232,8 @@ def main(argv: Optional[list[str]] = None) -> int:
     for local in ("--jsonl", "--include"):  # where rows were copied or merged from: not what was measured
         while local in given:
             del given[given.index(local):given.index(local) + 2]
-    command = " ".join(["python benchmarks/skip_idle.py"] + given)
+    threads = os.environ.get("OCTAX_CPU_THREADS")  # XLA:CPU's pool (octax_core.host), part of how it ran
+    command = " ".join(([f"OCTAX_CPU_THREADS={threads}"] if threads else []) + ["python benchmarks/skip_idle.py"] + given)
     games = select_games(args.games)
     ns = [int(n) for n in args.envs.split(",")]
     more = [int(n) for n in args.skipping_envs.split(",") if n.strip()]
