@@ -12,7 +12,7 @@ bit, on a machine whose predicate is false. Then running it for the whole batch,
 it, changes nothing for any machine, and no select over the (large) operands is needed.
 
 The skip pays on a CPU, where the batch's work is the time. On a GPU the loop's predicate is read
-back to the host before each trip (a device-to-host sync, three gates an instruction), which cost
+back to the host before each trip (a device-to-host sync, up to four gates an instruction), which cost
 more than the work it skips: there the work simply runs for the whole batch, which the contract
 makes the same. `LOOPED_PLATFORMS` names where the gate loops; `jax.lax.platform_dependent`
 picks per platform when the program is lowered, so one traced program serves both.
