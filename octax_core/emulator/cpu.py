@@ -277,9 +277,11 @@ def _plane_data(sprite: _Sprite, plane: int):
 
 
 def _plane_patterns(sprite: _Sprite, planes: range):
-    """((len(planes), 16) uint32 rows, zero on the planes the sprite is not drawn on; height)."""
+    """((len(planes), 16) uint32 rows, zero on the planes the sprite is not drawn on; height).
+    Only the platforms with planes get here, and all of them draw 16x16 at N = 0
+    (`Platform.wide_sprites`)."""
     data = jnp.stack([_plane_data(sprite, plane) for plane in planes])
-    patterns, height = display.sprite_patterns(data, sprite.n, True)
+    patterns, height = display.sprite_patterns(data, sprite.n, wide_sprites=True)
     drawn = ((sprite.planes >> jnp.asarray(list(planes), jnp.int32)) & 1) == 1
     return jnp.where(drawn[:, None], patterns, jnp.uint32(0)), height
 
