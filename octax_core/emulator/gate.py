@@ -73,18 +73,9 @@ def any_of_batch(*preds: jax.Array) -> tuple[jax.Array, ...]:
 
     @each.def_vmap
     def each_batched(axis_size, in_batched, preds):
-        (batched,) = in_batched
-        columns = [jnp.broadcast_to(p, (axis_size,)) if b else None for p, b in zip(preds, batched)]
-        stacked = jnp.stack([c for c in columns if c is not None], axis=1) if any(batched) else None
-        anyone = jnp.any(stacked, axis=0) if stacked is not None else None
-        out, k = [], 0
-        for p, b in zip(preds, batched):
-            if b:
-                out.append(anyone[k])
-                k += 1
-            else:
-                out.append(p)
-        return tuple(out), tuple(False for _ in preds)
+        # A predicate the batch shares is broadcast: any of its copies is itself.
+        stacked = jnp.stack([jnp.broadcast_to(p, (axis_size,)) for p in preds], axis=1)
+        return tuple(jnp.any(stacked, axis=0)), tuple(False for _ in preds)
 
     return each(tuple(jnp.asarray(p, jnp.bool_) for p in preds))
 
