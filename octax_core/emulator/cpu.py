@@ -100,7 +100,10 @@ class Fetched(NamedTuple):
     fields: Decoded
     kind: jax.Array  # int32 Kind; STALL while the frame is over (display wait)
     context: Context
-    at_i: jax.Array  # int32 bytes at I: the 16 of the window, 32 (a 16x16 sprite) on SUPER-CHIP, 64 (two) on XO-CHIP
+    at_i: jax.Array  # uint8 bytes at I: the 16 of the window, 32 (a 16x16 sprite) on SUPER-CHIP, 64 (two) on
+    #                  XO-CHIP; as read, not widened, which the gated draws take as an input (`_Sprite`)
+    #                  and XLA then fills for every instruction: 4x the bytes in int32 (measured, 8% of a
+    #                  SUPER-CHIP instruction at N = 512)
 
 
 def fetch(platform: Platform, quirks: Quirks, state: MachineState, keys, stalled=None) -> Fetched:
@@ -114,8 +117,7 @@ def fetch(platform: Platform, quirks: Quirks, state: MachineState, keys, stalled
     pc, I = state.pc.astype(jnp.int32), state.I.astype(jnp.int32)
     code = jax.lax.dynamic_slice(state.memory, (pc + MEMORY_OFFSET,), (platform.fetch_bytes,)).astype(jnp.int32)
     at_i = jax.lax.dynamic_slice(state.memory, (I + MEMORY_OFFSET,), (_bytes_at_i(platform),))
-    at_i = at_i.astype(jnp.int32)
-    window = at_i[:16]
+    window = at_i[:16].astype(jnp.int32)
     fields = decode(code[0], code[1], platform)
     kind = fields.kind if stalled is None else jnp.where(stalled, int(Kind.STALL), fields.kind)
     V, sp = state.V.astype(jnp.int32), state.sp.astype(jnp.int32)
@@ -259,7 +261,7 @@ class _Sprite(NamedTuple):
     opcode's N, the planes the machine draws this sprite on (bits; 0 where it draws nothing on
     that surface, which makes the draw a no-op), and where."""
 
-    at_i: jax.Array  # (32 * planes,) int32
+    at_i: jax.Array  # (32 * planes,) uint8
     n: jax.Array
     planes: jax.Array  # int32 bits: plane 1 = 1, plane 2 = 2
     x: jax.Array

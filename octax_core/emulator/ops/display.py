@@ -41,7 +41,7 @@ def sprite_patterns(data, n, wide_sprites: bool):
     """A sprite's rows as 16-pixel patterns, leftmost pixel in bit 31, and its height.
 
     Args:
-        data: (..., 16) int32 bytes at the sprite's address; (..., 32) where `wide_sprites`.
+        data: (..., 16) bytes (any integer dtype) at the sprite's address; (..., 32) where `wide_sprites`.
         n: the opcode's N: the height, or 0 for SUPER-CHIP's 16x16 sprite (two bytes a row).
         wide_sprites: whether N = 0 means 16x16 (SUPER-CHIP and XO-CHIP; static). On CHIP-8
             it means no rows.
