@@ -257,25 +257,15 @@ def _bytes_at_i(platform: Platform) -> int:
 
 
 class _Sprite(NamedTuple):
-    """A sprite draw: the bytes fetched at I, the opcode's N, the planes the machine draws this
-    sprite on (bits; 0 where it draws nothing on that surface, which makes the draw a no-op),
-    and where (Vx, Vy; wrapped to a surface by `on`)."""
+    """What a gated draw reads (`_draw_hires`, `_draw_second_plane`): the bytes fetched at I, the
+    opcode's N, the planes the machine draws this sprite on (bits; 0 where it draws nothing on
+    that surface, which makes the draw a no-op), and where."""
 
     at_i: jax.Array  # (32 * planes,) uint8
     n: jax.Array
     planes: jax.Array  # int32 bits: plane 1 = 1, plane 2 = 2
     x: jax.Array
     y: jax.Array
-
-    def on(self, hires, surface) -> "_Sprite":
-        """This sprite as the surface of one mode (`display.LORES` or `display.HIRES`) sees it,
-        for a machine in hires or not: no planes on the other mode's surface, the coordinates
-        wrapped at its size. The gated draws call it inside their gate: what a gate's work
-        takes as input is a buffer XLA fills on every instruction, so they take the sprite as
-        fetched (arrays that exist anyway) and derive the rest only when they run."""
-        rows, words = surface
-        planes = jnp.where(hires, self.planes, 0) if surface == display.HIRES else jnp.where(hires, 0, self.planes)
-        return self._replace(planes=planes, x=self.x & (32 * words - 1), y=self.y & (rows - 1))
 
 
 def _plane_data(sprite: _Sprite, plane: int):
@@ -322,32 +312,32 @@ def _needs(platform: Platform, c: Context, effect: Effect, drawing) -> Optional[
 def _scroll_and_clear_hires(platform: Platform, state: MachineState, effect: Effect, c: Context, needs):
     """The (screen, grid) after a scroll of the selected planes (of the 64x32 screen in lores, of
     the grid in hires) or a hires clear, under `when_any`: most instructions of most batches
-    have neither. CHIP-8 has neither. The gates take the effect's fields as merged and derive
-    the rest inside (`_change_planes`), as the gated draws do (`_Sprite.on`)."""
+    have neither. CHIP-8 has neither."""
     if not platform.extended:
         return state.screen, None
-    change = (effect.clear_planes, c.plane, effect.scroll_x, effect.scroll_y, c.hires)
-    grid = when_any(needs.grid_change, _change_planes(platform, display.HIRES), state.extension.grid, change)
-    screen = when_any(needs.screen_scroll, _change_planes(platform, display.LORES), state.screen, change)
+    planes = jnp.arange(platform.planes, dtype=jnp.int32)
+    cleared = ((effect.clear_planes >> planes) & 1) == 1
+    selected = ((c.plane >> planes) & 1) == 1
+    moving = (effect.scroll_x != 0) | (effect.scroll_y != 0)
+
+    def amounts(mode):  # a scroll moves the surface of the machine's mode; the other one stays
+        return jnp.where(mode, effect.scroll_x, 0), jnp.where(mode, effect.scroll_y, 0)
+
+    grid = when_any(needs.grid_change, _scroll_planes, state.extension.grid,
+                    (cleared & c.hires, selected, *amounts(c.hires)))
+    screen = when_any(needs.screen_scroll, _scroll_planes, state.screen,
+                      (jnp.zeros_like(cleared), selected, *amounts(~c.hires)))
     return screen, grid
 
 
-def _change_planes(platform: Platform, surface):
-    """`when_any`'s work on the surface of one mode (`display.LORES`: the 64x32 screen, or
-    `display.HIRES`: the grid), a (planes, rows, words) array: in hires, the planes a clear
-    empties (a lores clear is the draw's, `_draw_lores`); then, for a machine in that mode, its
-    selected planes scrolled by (dx, dy) pixels of the surface. A no-op for a machine in the
-    other mode, or that neither clears nor scrolls."""
-    def change(planes_surface, inputs):
-        clear_planes, plane, scroll_x, scroll_y, hires = inputs
-        in_mode = hires if surface == display.HIRES else ~hires
-        bits = jnp.arange(platform.planes, dtype=jnp.int32)
-        cleared = (((clear_planes >> bits) & 1) == 1) & (surface == display.HIRES) & hires
-        selected = ((plane >> bits) & 1) == 1
-        planes_surface = jnp.where(cleared[:, None, None], jnp.uint32(0), planes_surface)
-        dx, dy = jnp.where(in_mode, scroll_x, 0), jnp.where(in_mode, scroll_y, 0)
-        return jnp.where(selected[:, None, None], display.scroll(planes_surface, dx, dy), planes_surface)
-    return change
+def _scroll_planes(surface, inputs):
+    """Clears the `cleared` planes of a (planes, rows, words) surface, then scrolls the selected
+    ones by (dx, dy) pixels of that surface. No-op where nothing is cleared and dx = dy = 0."""
+    cleared, selected, dx, dy = inputs
+    surface = jnp.where(cleared[:, None, None], jnp.uint32(0), surface)
+    return jnp.where(selected[:, None, None], display.scroll(surface, dx, dy), surface)
+
+
 
 
 def _draw(platform: Platform, quirks: Quirks, screen, grid, fetched: Fetched, drawing, effect: Effect, needs):
@@ -364,8 +354,8 @@ def _draw(platform: Platform, quirks: Quirks, screen, grid, fetched: Fetched, dr
         mask = display.sprite_mask(patterns, c.vx & 63, c.vy & 31, jnp.where(drawing, height, 0), display.LORES,
                                    quirks.clipping)
         return _draw_lores(platform, screen, mask, effect, c), None, display.collides(screen, mask)
-    sprite = _Sprite(fetched.at_i, n, jnp.where(drawing, c.plane, 0), c.vx, c.vy)
-    lores = sprite.on(c.hires, display.LORES)
+    drawn = jnp.where(drawing, c.plane, 0)
+    lores = _Sprite(fetched.at_i, n, jnp.where(c.hires, 0, drawn), c.vx & 63, c.vy & 31)
     patterns, height = _plane_patterns(lores, range(1))
     mask = display.sprite_mask(patterns, lores.x, lores.y, height, display.LORES, quirks.clipping)
     collision = display.collides(screen[:1], mask)
@@ -378,9 +368,10 @@ def _draw(platform: Platform, quirks: Quirks, screen, grid, fetched: Fetched, dr
     own_clipping = None if fixed else quirks.clipping
     if platform.planes > 1:
         screen, collision = when_any(needs.second_plane, _draw_second_plane(clipping), (screen, collision),
-                                     (sprite, c.hires, own_clipping))
+                                     (lores, own_clipping))
+    hires = _Sprite(fetched.at_i, n, jnp.where(c.hires, drawn, 0), c.vx & 127, c.vy & 63)
     grid, hires_collision = when_any(needs.hires_sprite, _draw_hires(platform, clipping), (grid, jnp.bool_(False)),
-                                     (sprite, c.hires, own_clipping))
+                                     (hires, own_clipping))
     return screen, grid, jnp.where(c.hires, hires_collision, collision)
 
 
@@ -389,8 +380,7 @@ def _draw_second_plane(clipping):
     draw or of this one. `clipping` a constant, or None to read the machine's own from the inputs
     (a mix of profiles)."""
     def draw(operands, inputs):
-        (screen, collision), (sprite, hires, own_clipping) = operands, inputs
-        sprite = sprite.on(hires, display.LORES)
+        (screen, collision), (sprite, own_clipping) = operands, inputs
         patterns, height = _plane_patterns(sprite, range(1, 2))
         mask = display.sprite_mask(patterns, sprite.x, sprite.y, height, display.LORES,
                                    clipping if own_clipping is None else own_clipping)
@@ -402,8 +392,7 @@ def _draw_hires(platform: Platform, clipping):
     """The hires draw under `when_any`, every plane: `clipping` a constant, or None to read the
     machine's own from the inputs (a mix of profiles)."""
     def draw(operands, inputs):
-        (grid, _), (sprite, hires, own_clipping) = operands, inputs
-        sprite = sprite.on(hires, display.HIRES)
+        (grid, _), (sprite, own_clipping) = operands, inputs
         patterns, height = _plane_patterns(sprite, range(platform.planes))
         mask = display.sprite_mask(patterns, sprite.x, sprite.y, height, display.HIRES,
                                    clipping if own_clipping is None else own_clipping)
