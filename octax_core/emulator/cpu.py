@@ -28,7 +28,7 @@ from octax_core.emulator.opcodes import LEVELS, OPCODES, Kind
 from octax_core.emulator.ops import Context, Effect, alu, display, extended, flow, keys, memory, timers
 from octax_core.emulator.platforms import Platform
 from octax_core.emulator.quirks import Quirks
-from octax_core.emulator.state import MEMORY_OFFSET, SCREEN_HEIGHT, Extension, MachineState
+from octax_core.emulator.state import MEMORY_OFFSET, Extension, MachineState
 
 HANDLERS = {
     Kind.STALL: flow.op_stall,
@@ -318,7 +318,6 @@ def _scroll_and_clear_hires(platform: Platform, state: MachineState, effect: Eff
     planes = jnp.arange(platform.planes, dtype=jnp.int32)
     cleared = ((effect.clear_planes >> planes) & 1) == 1
     selected = ((c.plane >> planes) & 1) == 1
-    moving = (effect.scroll_x != 0) | (effect.scroll_y != 0)
 
     def amounts(mode):  # a scroll moves the surface of the machine's mode; the other one stays
         return jnp.where(mode, effect.scroll_x, 0), jnp.where(mode, effect.scroll_y, 0)
