@@ -101,8 +101,11 @@ def _shard_map(f, **kwargs):
     return shard_map(f, check_rep=False, **kwargs)
 
 
-def compile_rollout(rollout: Callable, inputs, actions, devices: int = 1):
+def compile_rollout(rollout: Callable, inputs, actions, devices: int = 1, compiler_options=None):
     """jit (and, for several devices, shard_map over the batch axis) then AOT-compile.
+
+    `compiler_options`: ours pass the platform's (`env.compiler_options`, as octax-gym's own
+    steps compile); the octax package's rollout compiles as that package does, with none.
 
     Returns a no-argument function running the compiled rollout on its inputs (placed where it
     wants them), the compile time and the number of devices used (1 when N does not split evenly).
@@ -116,10 +119,11 @@ def compile_rollout(rollout: Callable, inputs, actions, devices: int = 1):
         # Each device runs the plain per-env rollout on its slice; nothing crosses devices. The
         # varying-manual-axes check is off because it also rejects loop carries that start as
         # constants inside the code under test (octax's or ours), which is harmless here.
-        fn = jax.jit(_shard_map(rollout, mesh=mesh, in_specs=(P("env"), P("env")), out_specs=P("env")))
+        fn = jax.jit(_shard_map(rollout, mesh=mesh, in_specs=(P("env"), P("env")), out_specs=P("env")),
+                     compiler_options=compiler_options)
         inputs, actions = jax.device_put((inputs, actions), NamedSharding(mesh, P("env")))
     else:
-        devices, fn = 1, jax.jit(rollout)
+        devices, fn = 1, jax.jit(rollout, compiler_options=compiler_options)
     inputs, actions = jax.block_until_ready((inputs, actions))
     t0 = time.perf_counter()
     compiled = fn.lower(inputs, actions).compile()

@@ -68,7 +68,7 @@ def prepare(env, params, n: int, steps: int, games=None) -> Prepared:
         (states, keys), rewards = jax.lax.scan(one, (states, keys), length=steps)
         return states, rewards
 
-    run, compile_s, _ = compile_rollout(rollout, states, keys)
+    run, compile_s, _ = compile_rollout(rollout, states, keys, compiler_options=env.compiler_options)
     return Prepared(run, compile_s, state_bytes(states), 0)
 
 

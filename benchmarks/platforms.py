@@ -119,7 +119,7 @@ def prepare(machine, rom: Path, n: int, args: argparse.Namespace) -> Prepared:
     def rollout(states, actions):
         return jax.lax.scan(lambda s, _: (step(s, actions), None), states, length=args.steps)[0]
 
-    run, compile_s, devices = compile_rollout(rollout, states, actions)
+    run, compile_s, devices = compile_rollout(rollout, states, actions, compiler_options=machine.compiler_options)
     return Prepared(run, compile_s, state_bytes(states), FRAMES_PER_STEP * machine.instructions_per_frame, devices)
 
 

@@ -97,9 +97,11 @@ def prepare(game: str, skip_idle: bool, num_envs: int, steps: int, seed: int) ->
     keys = jax.random.split(jax.random.fold_in(key, 1), (steps, num_envs))
     start = jax.jit(jax.vmap(env.reset, in_axes=(0, None)))(jax.random.split(key, num_envs), params)
     t0 = time.perf_counter()
-    compiled = jax.jit(functools.partial(rollout, fingerprints=False)).lower(start, keys, actions).compile()
+    compiled = jax.jit(functools.partial(rollout, fingerprints=False),
+                       compiler_options=env.compiler_options).lower(start, keys, actions).compile()
     compile_s = time.perf_counter() - t0
-    outputs = {"checked": jax.jit(functools.partial(rollout, fingerprints=True))(start, keys, actions)}
+    outputs = {"checked": jax.jit(functools.partial(rollout, fingerprints=True),
+                                  compiler_options=env.compiler_options)(start, keys, actions)}
 
     def run():
         outputs["last"] = compiled(start, keys, actions)

@@ -133,7 +133,7 @@ def prepare_machine(rom: Path, n: int, args: argparse.Namespace) -> Prepared:
         states, _ = jax.lax.scan(lambda s, _: (step(s, actions), None), states, length=args.steps)
         return states
 
-    run, compile_s, devices = compile_rollout(rollout, states, actions, args.devices)
+    run, compile_s, devices = compile_rollout(rollout, states, actions, args.devices, machine.compiler_options)
     return Prepared(run, compile_s, state_bytes(states), FRAMES_PER_STEP * INSTRUCTIONS_PER_FRAME, devices)
 
 
@@ -164,7 +164,8 @@ def prepare_env(rom: Path, n: int, args: argparse.Namespace, **overrides) -> Pre
         carry, _ = jax.lax.scan(body, carry, length=args.steps)
         return carry
 
-    run, compile_s, devices = compile_rollout(rollout, (keys, states, obs), actions, args.devices)
+    run, compile_s, devices = compile_rollout(rollout, (keys, states, obs), actions, args.devices,
+                                              env.compiler_options)
     return Prepared(run, compile_s, state_bytes(states), FRAMES_PER_STEP * INSTRUCTIONS_PER_FRAME, devices)
 
 

@@ -71,7 +71,7 @@ def prepare(env, params, n: int, steps: int, seats: Optional[int]) -> Prepared:
         (states, keys), rewards = jax.lax.scan(one, (states, keys), length=steps)
         return states, rewards
 
-    run, compile_s, _ = compile_rollout(rollout, states, keys)
+    run, compile_s, _ = compile_rollout(rollout, states, keys, compiler_options=env.compiler_options)
     return Prepared(run, compile_s, state_bytes(states), env.config.frames_per_step * env.config.instructions_per_frame)
 
 

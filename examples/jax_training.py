@@ -154,7 +154,7 @@ def make_evaluate(env: octax_core.Env, env_params: octax_core.EnvParams, num_env
         _, _, _, _, returns, ended = jax.lax.while_loop(running, body, carry)
         return returns, ended
 
-    return jax.jit(evaluate) if jit else evaluate
+    return jax.jit(evaluate, compiler_options=env.compiler_options) if jit else evaluate
 
 
 def random_act(num_actions: int) -> Callable:
@@ -242,11 +242,14 @@ def train(config: RunConfig, make_train: Callable, out_dir, game=None, rom=None,
     trainer = make_train(config, env, env_params)
     seeds = config.num_seeds
     eval_steps = config.eval_max_steps or int(env_params.max_episode_steps)
+    # Every jit that steps the env takes its platform's compiler options (exact; faster kernels).
+    options = env.compiler_options
     evaluate_policy = jax.jit(over_seeds(
-        make_evaluate(eval_env, env_params, config.eval_envs, eval_steps, trainer.act, jit=False), seeds))
+        make_evaluate(eval_env, env_params, config.eval_envs, eval_steps, trainer.act, jit=False), seeds),
+        compiler_options=options)
     evaluate_random = jax.jit(over_seeds(
         make_evaluate(eval_env, env_params, config.eval_envs, eval_steps, random_act(env.num_actions), jit=False),
-        seeds, in_axes=(None, 0)))
+        seeds, in_axes=(None, 0)), compiler_options=options)
 
     if not resume and writer:
         (out_dir / "config.json").write_text(json.dumps(
@@ -266,7 +269,8 @@ def train(config: RunConfig, make_train: Callable, out_dir, game=None, rom=None,
                      "out_shardings": (parallel.shardings(runner), parallel.replicated)}
     compile_start = time.perf_counter()
     # Compiled ahead of time, so every timed call below runs and none compiles.
-    update = jax.jit(over_seeds(trainer.update, seeds), donate_argnums=0, **shardings).lower(runner).compile()
+    update = jax.jit(over_seeds(trainer.update, seeds), donate_argnums=0, compiler_options=options,
+                     **shardings).lower(runner).compile()
     print(f"compiled the {trainer.name} update in {time.perf_counter() - compile_start:.1f} s "
           f"({seeds} seed{'s' * (seeds > 1)} x {config.num_envs} envs x {config.num_steps} steps, "
           f"{config.num_updates} updates)")

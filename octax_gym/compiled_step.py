@@ -74,8 +74,12 @@ class CompiledStep:
         else:
             self.info = jax.vmap(lambda state: opponent.learner_info(env.info(state), view.seat))
             self._autoreset = jax.vmap(self._learner_autoreset, in_axes=(0, 0, 0, 0, None))
-        self.reset = jax.jit(self._reset)
-        self.step = {mode: jax.jit(functools.partial(self._step, mode=mode), donate_argnums=(1,))
+        # The platform's measured XLA settings (`Platform.compiler_options`); an outer jit that
+        # calls these (a dataset collector's step, a sharded step) passes them too.
+        self.compiler_options = env.compiler_options
+        self.reset = jax.jit(self._reset, compiler_options=self.compiler_options)
+        self.step = {mode: jax.jit(functools.partial(self._step, mode=mode), donate_argnums=(1,),
+                                   compiler_options=self.compiler_options)
                      for mode in AutoresetMode}
 
     # batched: keys (N,), state EnvState with (N, ...) leaves

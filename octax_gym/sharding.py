@@ -62,16 +62,17 @@ class Shards:
         self.num_local = len(self.global_env_ids)
         self.device = self.local_devices[0]
 
-    def partitioned(self, fn):
+    def partitioned(self, fn, compiler_options=None):
         """`fn` (a jitted batched step or reset) jitted again with its batched outputs constrained
         to the batch sharding, so each device computes and keeps its own lanes (left to itself,
-        XLA's propagation may replicate an output on every device)."""
+        XLA's propagation may replicate an output on every device). The outer jit compiles `fn`
+        with it, so it takes `fn`'s `compiler_options`."""
         def constrain(x):
             if isinstance(x, jax.Array) and x.ndim and x.shape[0] == self.global_num_envs:
                 return jax.lax.with_sharding_constraint(x, self.batch)
             return x
 
-        return jax.jit(lambda *args: jax.tree.map(constrain, fn(*args)))
+        return jax.jit(lambda *args: jax.tree.map(constrain, fn(*args)), compiler_options=compiler_options)
 
     def to_global(self, local) -> jax.Array:
         """This process's rows (num_local, ...) of a batched array as the global (num_envs, ...) array."""

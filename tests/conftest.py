@@ -35,14 +35,16 @@ def pytest_runtest_setup(item):
 
 @functools.lru_cache(maxsize=None)
 def jitted_run_frames(machine: octax_core.Machine):
-    """`machine.run_frames` jitted with `frames` static; one compile per (machine, frames)."""
-    return jax.jit(machine.run_frames, static_argnums=2)
+    """`machine.run_frames` jitted with `frames` static; one compile per (machine, frames). With the
+    platform's compiler options, as octax-gym's own steps compile it (the differential tests
+    check the program that ships)."""
+    return jax.jit(machine.run_frames, static_argnums=2, compiler_options=machine.compiler_options)
 
 
 @functools.lru_cache(maxsize=None)
 def jitted_execute(machine: octax_core.Machine):
-    """`machine.execute` (one instruction) jitted; one compile per machine."""
-    return jax.jit(machine.execute)
+    """`machine.execute` (one instruction) jitted, with the platform's compiler options; one compile per machine."""
+    return jax.jit(machine.execute, compiler_options=machine.compiler_options)
 
 
 @pytest.fixture(scope="session")

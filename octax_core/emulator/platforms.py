@@ -11,6 +11,10 @@ here: the opcodes it decodes (`level`), how many bytes it fetches (`fetch_bytes`
 addresses wrap (`memory_size`), how much of RAM's start is mirrored after it (`mirrored_bytes`),
 the bit planes and their grid (`planes`, `extended`), and whether N = 0 draws a 16x16 sprite.
 CHIP-8 is the smallest case of each.
+
+A platform also carries the XLA compile options its programs run fastest under
+(`compiler_options`), measured per platform; they change how XLA:CPU lays out buffers, never
+what a program computes, and the jitted steps of octax-gym pass them to `jax.jit`.
 """
 
 from __future__ import annotations
@@ -31,6 +35,8 @@ class Platform:
         memory_size: bytes of RAM; every address wraps at this size.
         planes: bit planes of the 128x64 display (0 for CHIP-8's own 64x32 one-plane display).
         default_quirks: the quirk profile a `Machine` on this platform uses unless told.
+        xla_options: (name, value) pairs of XLA debug options for compiling this platform's
+            programs; `compiler_options` gives them as the dict `jax.jit` takes.
     """
 
     name: str
@@ -38,6 +44,22 @@ class Platform:
     memory_size: int
     planes: int
     default_quirks: str
+    xla_options: tuple[tuple[str, object], ...] = ()
+
+    @property
+    def compiler_options(self) -> dict[str, object]:
+        """`jax.jit(..., compiler_options=...)` for this platform's programs.
+
+        Why: XLA:CPU's default copy insertion copies most of the instruction loop's registers on
+        every instruction (CHIP-8: 10 copies among 38 kernels at N = 512); its region analysis
+        proves those copies needless and drops them. That is +20-24% on CHIP-8 and +10-30% on
+        XO-CHIP, but -8 to -22% on SUPER-CHIP with the default two-thread pool, where the copies
+        let independent kernels run side by side (docs/machine.md has the numbers). As an
+        `XLA_FLAGS` flag it would set every program in the process, so it rides here, per
+        compile. It changes buffers, not results: tests/core_emulator/test_compiler_options.py
+        compares every step with and without it.
+        """
+        return dict(self.xla_options)
 
     @property
     def extended(self) -> bool:
@@ -80,10 +102,13 @@ class Platform:
         return (64, 128) if self.planes == 1 else (self.planes, 64, 128)
 
 
+# Region-analysis copy insertion (see `Platform.compiler_options`).
+_FEWER_COPIES = (("xla_cpu_copy_insertion_use_region_analysis", True),)
+
 PLATFORMS: dict[str, Platform] = {
-    "chip8": Platform("chip8", 0, 0x1000, 0, "chip8"),
+    "chip8": Platform("chip8", 0, 0x1000, 0, "chip8", _FEWER_COPIES),
     "schip": Platform("schip", 1, 0x1000, 1, "schip"),
-    "xochip": Platform("xochip", 2, 0x10000, 2, "xochip"),
+    "xochip": Platform("xochip", 2, 0x10000, 2, "xochip", _FEWER_COPIES),
 }
 
 

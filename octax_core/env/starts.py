@@ -50,7 +50,8 @@ def boot(machine: Machine, rom: Rom, startup: tuple[tuple[int, int], ...]) -> Ma
 @functools.lru_cache(maxsize=None)
 def _frames_runner(machine: Machine):
     """`machine.run_frames` with the frame count traced: one compile per machine config."""
-    return jax.jit(lambda state, mask, frames: machine.run_frames(state, mask, frames))
+    return jax.jit(lambda state, mask, frames: machine.run_frames(state, mask, frames),
+                   compiler_options=machine.compiler_options)
 
 
 def noop_pool(template: MachineState, noop_step: Callable[[MachineState], MachineState],

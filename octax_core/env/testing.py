@@ -41,8 +41,8 @@ def check_env(game: Union[str, GameSpec], *, num_envs: int = 3, steps: int = 12,
         traces.append(None)  # runs once per trace, never per call
         return env.step(key, state, action, params)
 
-    reset = jax.jit(jax.vmap(env.reset, in_axes=(0, None)))
-    step = jax.jit(jax.vmap(counted_step, in_axes=(0, 0, 0, None)))
+    reset = jax.jit(jax.vmap(env.reset, in_axes=(0, None)), compiler_options=env.compiler_options)
+    step = jax.jit(jax.vmap(counted_step, in_axes=(0, 0, 0, None)), compiler_options=env.compiler_options)
     _check_outputs(env, params, reset, step, keys)
     _check_action_refused(env, params, reset, keys)
     batched = _rollout(reset, step, params, keys, actions)

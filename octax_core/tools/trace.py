@@ -186,7 +186,7 @@ def _rollout(env: Env, policy: str, stall_steps: int):
         # Every reset gives the same registers (it only reseeds the random state): return them once.
         return state.machine.V, jax.lax.scan(step, (state, jnp.int32(0)), keys[1:])[1]
 
-    return jax.jit(jax.vmap(play, in_axes=(0, None)))
+    return jax.jit(jax.vmap(play, in_axes=(0, None)), compiler_options=env.compiler_options)
 
 
 def _unchanged(before, after) -> jax.Array:

@@ -255,7 +255,7 @@ def _step_and_reset(compiled: compiled_step.CompiledStep):
         return keys, state, (last, reward, terminated, truncated, _unmasked(info), obs, _unmasked(first_info),
                              seeds)
 
-    return jax.jit(step_and_reset, donate_argnums=(1,))
+    return jax.jit(step_and_reset, donate_argnums=(1,), compiler_options=compiled.compiler_options)
 
 
 def _unmasked(info: dict) -> dict:

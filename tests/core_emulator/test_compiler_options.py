@@ -1,0 +1,79 @@
+"""Each platform's XLA compile options (`Platform.compiler_options`): exact, and really passed.
+
+The options change how XLA:CPU places buffers (region-analysis copy insertion drops the loop's
+register copies), never what a program computes. These tests hold that to the bit: an archive game
+of each platform, stepped by a vmapped env under random actions, gives the same observations,
+rewards, flags, info and machine state compiled plainly and compiled with the options, and with
+region analysis forced on where the platform leaves it off. tests/gym_layer/test_compiler_options_gym.py
+checks that the options reach the compiles that ship.
+"""
+
+from __future__ import annotations
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+import pytest
+
+import octax_core
+from octax_core.emulator.platforms import PLATFORMS
+
+REGION_ANALYSIS = {"xla_cpu_copy_insertion_use_region_analysis": True}
+# An archive game of each platform (they ship in the package: no ../shared needed).
+GAMES = {"chip8": "Carbon8", "schip": "Rockto", "xochip": "FlutterBy"}
+NUM_ENVS, STEPS = 3, 24
+
+
+def _rollout(env, params):
+    step = jax.vmap(env.step, in_axes=(0, 0, 0, None))
+    reset = jax.vmap(env.reset, in_axes=(0, None))
+
+    def rollout(keys, actions):
+        obs, state = reset(keys[0], params)
+
+        def body(state, xs):
+            step_keys, action = xs
+            obs, state, reward, terminated, truncated, info = step(step_keys, state, action, params)
+            return state, (obs, reward, terminated, truncated, info)
+
+        return jax.lax.scan(body, state, (keys[1:], actions))
+
+    return rollout
+
+
+def _plain(tree):
+    return [np.asarray(jax.random.key_data(x) if jnp.issubdtype(x.dtype, jax.dtypes.prng_key) else x)
+            for x in jax.tree.leaves(tree)]
+
+
+@pytest.mark.parametrize("platform", sorted(GAMES))
+def test_every_step_is_the_same_with_the_options(platform):
+    env, params = octax_core.make(GAMES[platform])
+    assert env.machine.platform.name == platform
+    keys = jax.random.split(jax.random.key(7), (STEPS + 1, NUM_ENVS))
+    actions = jax.random.randint(jax.random.key(8), (STEPS, NUM_ENVS), 0, env.num_actions)
+    rollout = _rollout(env, params)
+    plain = jax.jit(rollout)(keys, actions)  # (final state, (obs, reward, terminated, truncated, info))
+    for options in (env.compiler_options, {**env.compiler_options, **REGION_ANALYSIS}):
+        tuned = jax.jit(rollout, compiler_options=options)(keys, actions)
+        assert jax.tree.structure(tuned) == jax.tree.structure(plain)
+        for a, b in zip(_plain(plain), _plain(tuned)):
+            np.testing.assert_array_equal(a, b, err_msg=f"{platform} with {options}")
+    # The rollout did something: the screens changed.
+    screens = np.asarray(plain[1][0])
+    assert screens.shape[:2] == (STEPS, NUM_ENVS) and (screens[0] != screens[-1]).any()
+
+
+def test_the_options_are_the_platforms_and_pass_through_machine_and_env():
+    for platform in PLATFORMS.values():
+        options = platform.compiler_options
+        assert isinstance(options, dict) and options == dict(platform.xla_options)
+        assert octax_core.Machine(platform.name).compiler_options == options
+    env, _ = octax_core.make(GAMES["xochip"])
+    assert env.compiler_options == PLATFORMS["xochip"].compiler_options
+    # Every option is one XLA knows: a misspelt name fails the compile.
+    for platform in PLATFORMS.values():
+        jax.jit(lambda x: x + 1, compiler_options=platform.compiler_options)(jnp.int32(1))
+    with pytest.raises(Exception, match="No such compile option"):
+        jax.jit(lambda x: x + 1, compiler_options={"xla_cpu_no_such_option": True})(jnp.int32(2))
+
