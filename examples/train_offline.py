@@ -116,10 +116,11 @@ def run_dataset(algorithm: str, ident: str, args) -> dict:
 
     env, env_params = octax_core.make(game, autoreset=False, **options)
     evaluate = make_evaluate(env, env_params, args.eval_envs, int(env_params.max_episode_steps), act, jit=False)
-    evaluate = jax.jit(jax.vmap(evaluate))
+    evaluate = jax.jit(jax.vmap(evaluate), compiler_options=env.compiler_options)
     returns, ended = jax.device_get(evaluate(states["params"], jax.vmap(lambda s: jax.random.key(10_000 + s))(seeds)))
     random_eval = jax.jit(make_evaluate(env, env_params, args.eval_envs, int(env_params.max_episode_steps),
-                                        lambda _, key, obs: jax.random.randint(key, obs.shape[:1], 0, num_actions)))
+                                        lambda _, key, obs: jax.random.randint(key, obs.shape[:1], 0, num_actions),
+                                        jit=False), compiler_options=env.compiler_options)
     random_return = float(jax.device_get(random_eval(None, jax.random.key(99))[0]).mean())
     dataset_return = float(np.mean([e.rewards.sum() for e in dataset.iterate_episodes()]))
     rows = []

@@ -74,13 +74,15 @@ class CompiledStep:
         else:
             self.info = jax.vmap(lambda state: opponent.learner_info(env.info(state), view.seat))
             self._autoreset = jax.vmap(self._learner_autoreset, in_axes=(0, 0, 0, 0, None))
-        # The platform's measured XLA settings (`Platform.compiler_options`); an outer jit that
-        # calls these (a dataset collector's step, a sharded step) passes them too.
+        # The platform's measured XLA settings (`Platform.compiler_options`). JAX takes compile
+        # options on the outermost jit only, so a caller that jits around the step (a dataset
+        # collector, a sharded env) calls the unjitted `reset_fn` / `step_fns` and passes them itself.
         self.compiler_options = env.compiler_options
-        self.reset = jax.jit(self._reset, compiler_options=self.compiler_options)
-        self.step = {mode: jax.jit(functools.partial(self._step, mode=mode), donate_argnums=(1,),
-                                   compiler_options=self.compiler_options)
-                     for mode in AutoresetMode}
+        self.reset_fn = self._reset
+        self.step_fns = {mode: functools.partial(self._step, mode=mode) for mode in AutoresetMode}
+        self.reset = jax.jit(self.reset_fn, compiler_options=self.compiler_options)
+        self.step = {mode: jax.jit(fn, donate_argnums=(1,), compiler_options=self.compiler_options)
+                     for mode, fn in self.step_fns.items()}
 
     # batched: keys (N,), state EnvState with (N, ...) leaves
 

@@ -63,10 +63,10 @@ class Shards:
         self.device = self.local_devices[0]
 
     def partitioned(self, fn, compiler_options=None):
-        """`fn` (a jitted batched step or reset) jitted again with its batched outputs constrained
-        to the batch sharding, so each device computes and keeps its own lanes (left to itself,
-        XLA's propagation may replicate an output on every device). The outer jit compiles `fn`
-        with it, so it takes `fn`'s `compiler_options`."""
+        """`fn` (a batched step or reset, unjitted: JAX takes `compiler_options` on the outermost
+        jit only) jitted with its batched outputs constrained to the batch sharding, so each
+        device computes and keeps its own lanes (left to itself, XLA's propagation may replicate
+        an output on every device)."""
         def constrain(x):
             if isinstance(x, jax.Array) and x.ndim and x.shape[0] == self.global_num_envs:
                 return jax.lax.with_sharding_constraint(x, self.batch)

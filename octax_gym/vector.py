@@ -175,8 +175,9 @@ class OctaxVectorEnv(gymnasium.vector.VectorEnv):
         self.params = jax.device_put(params, self.device) if self._shards is None else self._shards.replicate(params)
         self._step_fn, self._reset_fn = self._compiled.step[self.autoreset_mode], self._compiled.reset
         if self._shards is not None:
-            self._step_fn, self._reset_fn = (self._shards.partitioned(fn, self._compiled.compiler_options)
-                                             for fn in (self._step_fn, self._reset_fn))
+            self._step_fn, self._reset_fn = (
+                self._shards.partitioned(fn, self._compiled.compiler_options)
+                for fn in (self._compiled.step_fns[self.autoreset_mode], self._compiled.reset_fn))
         self._action_check = action_check.DeferredCheck(
             self.game_name, self.core_env.num_actions, self.device if self._shards is None else self._shards.replicated,
             self.agents)

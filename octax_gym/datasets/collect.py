@@ -246,12 +246,12 @@ def _step_and_reset(compiled: compiled_step.CompiledStep):
     """The lanes' jitted step for one game and config (cached, like the compiled step: one compile per
     batch size)."""
     def step_and_reset(keys, state, actions, next_seed, params):
-        keys, last, state, reward, terminated, truncated, info, _ = compiled.step[AutoresetMode.DISABLED](
+        keys, last, state, reward, terminated, truncated, info, _ = compiled.step_fns[AutoresetMode.DISABLED](
             keys, state, actions, jnp.asarray(action_check.NO_REPORT, jnp.int32), params)
         ended = terminated | truncated
         seeds = next_seed + jnp.cumsum(ended, dtype=jnp.uint32) - 1  # lane order
         keys = compiled_step.select_keys(ended, compiled_step.keys_from_seeds(seeds), keys)
-        keys, obs, state, first_info = compiled.reset(keys, state, last, ended, params)
+        keys, obs, state, first_info = compiled.reset_fn(keys, state, last, ended, params)
         return keys, state, (last, reward, terminated, truncated, _unmasked(info), obs, _unmasked(first_info),
                              seeds)
 
