@@ -287,7 +287,7 @@ def make_evaluate(mix: octax_core.Env, env_params, eval_envs: int, max_steps: in
         # lane j is game j mod G: (n,) -> (eval_envs, G) -> (G, eval_envs)
         return returns.reshape(eval_envs, num_games).T, ended.reshape(eval_envs, num_games).T
 
-    return jax.jit(evaluate)
+    return jax.jit(evaluate, compiler_options=mix.compiler_options)  # the platform's (exact; faster)
 
 
 def normalized(game: str, value: float) -> float:
@@ -337,7 +337,7 @@ def train(config: Config, out_dir, games=None, roms=None, progress: bool = True,
     train_key, eval_key, random_key = jax.random.split(jax.random.key(config.seed), 3)
     runner = jax.jit(trainer.init)(train_key)
     t0 = time.perf_counter()
-    update = jax.jit(trainer.update, donate_argnums=0).lower(runner).compile()
+    update = jax.jit(trainer.update, donate_argnums=0, compiler_options=mix.compiler_options).lower(runner).compile()
     print(f"compiled the multi-task update in {time.perf_counter() - t0:.1f} s ({len(names)} games, "
           f"{config.num_envs} envs x {config.num_steps} steps, {config.num_updates} updates, "
           f"{config.steps_per_game:,} env steps per game)")
