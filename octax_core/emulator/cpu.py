@@ -172,8 +172,9 @@ def sets(kind, effects: dict, field: str) -> jax.Array:
     return jnp.isin(kind, jnp.asarray(kinds, jnp.int32))
 
 
-def _defaults(state: MachineState, c: Context) -> Effect:
-    """What an instruction leaves alone: pc moves on by 2, everything else stays as it is."""
+def _defaults(platform: Platform, state: MachineState, c: Context) -> Effect:
+    """What an instruction leaves alone: pc moves on by 2, everything else stays as it is. A
+    field a platform's handlers never set has no default there (None), and `merge` skips it."""
     effect = Effect(pc=c.pc + 2, vx=c.vx, vf=jnp.int32(0), i=c.I, sp=c.sp, push=c.pc, mem_data=c.window,
                     mem_count=jnp.int32(0), load_count=jnp.int32(0), delay_timer=c.delay_timer,
                     sound_timer=state.sound_timer.astype(jnp.int32), rng=c.rng, key_wait=c.key_wait,
@@ -181,11 +182,14 @@ def _defaults(state: MachineState, c: Context) -> Effect:
     if state.extension is None:
         return effect
     ext = state.extension
-    return effect._replace(
-        v_lanes=jnp.zeros(16, jnp.bool_), v_values=c.V, scroll_x=jnp.int32(0), scroll_y=jnp.int32(0),
+    effect = effect._replace(
+        load_flags=jnp.bool_(False), scroll_x=jnp.int32(0), scroll_y=jnp.int32(0),
         hires=c.hires, exited=ext.exited, flags=c.flags, plane=c.plane,
         audio_pattern=ext.audio_pattern.astype(jnp.int32), pitch=ext.pitch.astype(jnp.int32),
     )
+    if platform.level < 2:
+        return effect
+    return effect._replace(v_lanes=jnp.zeros(16, jnp.bool_), v_values=c.V)
 
 
 def execute(platform: Platform, quirks: Quirks, state: MachineState, keys: jax.Array, stalled=None):
@@ -211,15 +215,10 @@ def execute(platform: Platform, quirks: Quirks, state: MachineState, keys: jax.A
     # version alive (a read of the old memory after the write cost a whole 64 KiB copy per
     # instruction on XO-CHIP, measured).
     effects = {k: handler(c) for k, handler in handlers(platform).items()}
-    defaults = _defaults(state, c)
+    defaults = _defaults(platform, state, c)
     before_drawing = merge(kind, effects, defaults)  # all but DXYN's VF, which needs the collision
     written = _write_memory(platform, state.memory, before_drawing, c)
-    # An instruction draws, clears or scrolls, never two of these, so their order is free: the
-    # rare ones first (scrolls, hires clears), each straight on the state's surfaces.
-    drawing = kind == Kind.DRW
-    needs = _needs(platform, c, before_drawing, drawing)
-    screen, grid = _scroll_and_clear_hires(platform, state, before_drawing, c, needs)
-    screen, grid, collision = _draw(platform, quirks, screen, grid, fetched, drawing, before_drawing, needs)
+    screen, grid, collision = _draw(platform, quirks, state, fetched, kind == Kind.DRW, before_drawing)
     effects[Kind.DRW] = display.op_dxyn(c._replace(collision=collision))
     effect = merge(kind, effects, defaults)
     return _apply(platform, state, kind, effects, effect, written, screen, grid, c), kind
@@ -289,7 +288,7 @@ def _plane_patterns(sprite: _Sprite, planes: range):
 
 
 class _Needs(NamedTuple):
-    """Whether some machine of the batch needs each gated work of this instruction (`_needs`)."""
+    """Whether a machine needs each gated work of this instruction (`_needs`)."""
 
     grid_change: jax.Array  # a hires scroll or clear
     screen_scroll: jax.Array  # a lores scroll
@@ -297,36 +296,128 @@ class _Needs(NamedTuple):
     hires_sprite: jax.Array  # a sprite on the grid
 
 
-def _needs(platform: Platform, c: Context, effect: Effect, drawing) -> Optional[_Needs]:
-    """Each gate's predicate, reduced over the batch at once (`gate.any_of_batch`). None on
-    CHIP-8, which has no gated work."""
-    if not platform.extended:
-        return None
+class _Rare(NamedTuple):
+    """What the rare work of an instruction reads (`_rare_work`), one machine's small integers.
+
+    They cross into the gate packed in one uint32 (`_pack`, widths in `_RARE_BITS`): every
+    separate input of a loop is a buffer XLA fills on every instruction, whether the loop runs
+    or not (one kernel each; XLA:CPU fills a stack of them row by row, then transposes it).
+    Measured as most of the gates' cost on a batch that never needs them."""
+
+    needs: jax.Array  # `_Needs` as bits: 1 grid change, 2 screen scroll, 4 second plane, 8 hires sprite
+    hires: jax.Array  # 1 in 128x64 mode (before this instruction), else 0
+    clear_planes: jax.Array  # the merged effect's cleared planes (bits)
+    plane: jax.Array  # the selected planes (bits), which drawing and scrolling act on
+    drawn: jax.Array  # the planes this instruction's sprite is drawn on (bits; 0 when it draws none)
+    scroll_x: jax.Array  # the merged effect's scroll, in pixels of the mode's surface: -4, 0 or 4
+    scroll_y: jax.Array  # -15..15
+    n: jax.Array  # the sprite's N
+
+
+# (bits, signed) of each `_Rare` field, packed from bit 0 up: 25 bits in all
+_RARE_BITS = ((4, False), (1, False), (2, False), (2, False), (2, False), (5, True), (5, True), (4, False))
+
+
+def _pack(rare: _Rare) -> jax.Array:
+    """The fields of `rare` in one uint32 (two's complement where signed)."""
+    word, at = jnp.uint32(0), 0
+    for value, (bits, _) in zip(rare, _RARE_BITS):
+        word = word | ((jnp.asarray(value).astype(jnp.uint32) & ((1 << bits) - 1)) << at)
+        at += bits
+    return word
+
+
+def _unpack(word) -> _Rare:
+    """`_pack`'s inverse: int32 fields."""
+    fields, at = [], 0
+    for bits, signed in _RARE_BITS:
+        value = ((word >> at) & ((1 << bits) - 1)).astype(jnp.int32)
+        fields.append(jnp.where(value >= 1 << (bits - 1), value - (1 << bits), value) if signed else value)
+        at += bits
+    return _Rare(*fields)
+
+
+_NEEDS_BITS = tuple(1 << k for k in range(len(_Needs._fields)))
+
+
+def _needs(platform: Platform, c: Context, effect: Effect, drawing) -> _Needs:
+    """Each gated work's predicate for this machine (SUPER-CHIP and XO-CHIP)."""
     moving = (effect.scroll_x != 0) | (effect.scroll_y != 0)
     drawn = jnp.where(drawing, c.plane, 0)
     second = ~c.hires & ((drawn & 2) != 0) if platform.planes > 1 else jnp.bool_(False)
-    return _Needs(*any_of_batch(c.hires & ((effect.clear_planes != 0) | moving), ~c.hires & moving, second,
-                                c.hires & (drawn != 0)))
+    return _Needs(c.hires & ((effect.clear_planes != 0) | moving), ~c.hires & moving, second,
+                  c.hires & (drawn != 0))
 
 
-def _scroll_and_clear_hires(platform: Platform, state: MachineState, effect: Effect, c: Context, needs):
-    """The (screen, grid) after a scroll of the selected planes (of the 64x32 screen in lores, of
-    the grid in hires) or a hires clear, under `when_any`: most instructions of most batches
-    have neither. CHIP-8 has neither."""
+def _draw(platform: Platform, quirks: Quirks, state: MachineState, fetched: Fetched, drawing, effect: Effect):
+    """DXYN, the clears and the scrolls: (the 64x32 screen, the grid, the collision).
+
+    The 64x32 surface (CHIP-8's screen; the lores screen of SUPER-CHIP and XO-CHIP) is cleared
+    and drawn by every machine on plane 1 (a zero mask where it does not draw). The rest (a
+    scroll, a hires clear, XO-CHIP's plane 2, the 128x64 grid) is rare work: it runs under one
+    `when_any`, when some machine of the batch needs some of it, and inside that each part
+    under its own (`_rare_work`). A CHIP-8 program run by SUPER-CHIP or XO-CHIP pays for one
+    predicate, one stacked input and one loop that does not run. An instruction draws, clears
+    or scrolls, never two of these, so their order is free: plane 1's draw goes first, straight
+    on the state's screen.
+    """
+    c, n = fetched.context, fetched.fields.n
     if not platform.extended:
-        return state.screen, None
-    planes = jnp.arange(platform.planes, dtype=jnp.int32)
-    cleared = ((effect.clear_planes >> planes) & 1) == 1
-    selected = ((c.plane >> planes) & 1) == 1
+        patterns, height = display.sprite_patterns(fetched.at_i, n, False)
+        mask = display.sprite_mask(patterns, c.vx & 63, c.vy & 31, jnp.where(drawing, height, 0), display.LORES,
+                                   quirks.clipping)
+        return _draw_lores(platform, state.screen, mask, effect, c), None, display.collides(state.screen, mask)
+    drawn = jnp.where(drawing, c.plane, 0)
+    lores = _Sprite(fetched.at_i, n, jnp.where(c.hires, 0, drawn), c.vx & 63, c.vy & 31)
+    patterns, height = _plane_patterns(lores, range(1))
+    mask = display.sprite_mask(patterns, lores.x, lores.y, height, display.LORES, quirks.clipping)
+    collision = display.collides(state.screen[:1], mask)
+    if platform.planes > 1:  # plane 2's mask is zero here: `_draw_second_plane` draws it
+        mask = jnp.concatenate([mask, jnp.zeros_like(mask)])
+    screen = _draw_lores(platform, state.screen, mask, effect, c)
+    needs = _needs(platform, c, effect, drawing)
+    rare = _Rare(needs=sum(jnp.where(need, bit, 0) for need, bit in zip(needs, _NEEDS_BITS)),
+                 hires=c.hires, clear_planes=effect.clear_planes, plane=c.plane, drawn=drawn,
+                 scroll_x=effect.scroll_x, scroll_y=effect.scroll_y, n=n)
+    # `when_any`'s work may close over constants only: a mix's per-machine clipping is an input
+    fixed = isinstance(quirks.clipping, bool)
+    return when_any(needs.grid_change | needs.screen_scroll | needs.second_plane | needs.hires_sprite,
+                    _rare_work(platform, quirks.clipping if fixed else None),
+                    (screen, state.extension.grid, collision),
+                    (_pack(rare), c.vx, c.vy, fetched.at_i, None if fixed else quirks.clipping))
 
-    def amounts(mode):  # a scroll moves the surface of the machine's mode; the other one stays
-        return jnp.where(mode, effect.scroll_x, 0), jnp.where(mode, effect.scroll_y, 0)
 
-    grid = when_any(needs.grid_change, _scroll_planes, state.extension.grid,
-                    (cleared & c.hires, selected, *amounts(c.hires)))
-    screen = when_any(needs.screen_scroll, _scroll_planes, state.screen,
-                      (jnp.zeros_like(cleared), selected, *amounts(~c.hires)))
-    return screen, grid
+def _rare_work(platform: Platform, clipping):
+    """The rare work of an instruction, each part under its own `when_any` (one reduction gives
+    their predicates, `gate.any_of_batch`): a hires scroll or clear, a lores scroll, XO-CHIP's
+    plane 2 sprite, a sprite on the grid. Operands (screen, grid, the collision: plane 1's, and
+    the grid's in hires); a no-op for a machine that needs none of it (a machine in hires that
+    draws nothing has no collision on either surface). `clipping` a constant, or None to read
+    the machine's own from the inputs (a mix of profiles)."""
+    def work(operands, inputs):
+        (screen, grid, collision), (packed, x, y, at_i, own_clipping) = operands, inputs
+        rare = _unpack(packed)
+        needs = _Needs(*any_of_batch(*((rare.needs & bit) != 0 for bit in _NEEDS_BITS)))
+        hires = rare.hires != 0
+        planes = jnp.arange(platform.planes, dtype=jnp.int32)
+        cleared = ((rare.clear_planes >> planes) & 1) == 1
+        selected = ((rare.plane >> planes) & 1) == 1
+
+        def amounts(mode):  # a scroll moves the surface of the machine's mode; the other one stays
+            return jnp.where(mode, rare.scroll_x, 0), jnp.where(mode, rare.scroll_y, 0)
+
+        grid = when_any(needs.grid_change, _scroll_planes, grid, (cleared & hires, selected, *amounts(hires)))
+        screen = when_any(needs.screen_scroll, _scroll_planes, screen,
+                          (jnp.zeros_like(cleared), selected, *amounts(~hires)))
+        if platform.planes > 1:
+            lores = _Sprite(at_i, rare.n, jnp.where(hires, 0, rare.drawn), x & 63, y & 31)
+            screen, collision = when_any(needs.second_plane, _draw_second_plane(clipping), (screen, collision),
+                                         (lores, own_clipping))
+        sprite = _Sprite(at_i, rare.n, jnp.where(hires, rare.drawn, 0), x & 127, y & 63)
+        grid, hires_collision = when_any(needs.hires_sprite, _draw_hires(platform, clipping),
+                                         (grid, jnp.bool_(False)), (sprite, own_clipping))
+        return screen, grid, jnp.where(hires, hires_collision, collision)
+    return work
 
 
 def _scroll_planes(surface, inputs):
@@ -335,43 +426,6 @@ def _scroll_planes(surface, inputs):
     cleared, selected, dx, dy = inputs
     surface = jnp.where(cleared[:, None, None], jnp.uint32(0), surface)
     return jnp.where(selected[:, None, None], display.scroll(surface, dx, dy), surface)
-
-
-
-
-def _draw(platform: Platform, quirks: Quirks, screen, grid, fetched: Fetched, drawing, effect: Effect, needs):
-    """DXYN, and the merged effect's lores clear: (the 64x32 screen, the grid, the collision).
-
-    The 64x32 surface (CHIP-8's screen; the lores screen of SUPER-CHIP and XO-CHIP) is drawn by
-    every machine on plane 1 (a zero mask where it does not draw); XO-CHIP's plane 2 there, and
-    the 128x64 grid, only under `when_any`, when some machine of the batch draws on them: a
-    CHIP-8 program run by XO-CHIP never pays for the second plane, nor one in lores for hires.
-    """
-    c, n = fetched.context, fetched.fields.n
-    if not platform.extended:
-        patterns, height = display.sprite_patterns(fetched.at_i, n, False)
-        mask = display.sprite_mask(patterns, c.vx & 63, c.vy & 31, jnp.where(drawing, height, 0), display.LORES,
-                                   quirks.clipping)
-        return _draw_lores(platform, screen, mask, effect, c), None, display.collides(screen, mask)
-    drawn = jnp.where(drawing, c.plane, 0)
-    lores = _Sprite(fetched.at_i, n, jnp.where(c.hires, 0, drawn), c.vx & 63, c.vy & 31)
-    patterns, height = _plane_patterns(lores, range(1))
-    mask = display.sprite_mask(patterns, lores.x, lores.y, height, display.LORES, quirks.clipping)
-    collision = display.collides(screen[:1], mask)
-    if platform.planes > 1:  # plane 2's mask is zero here: `_draw_second_plane` draws it
-        mask = jnp.concatenate([mask, jnp.zeros_like(mask)])
-    screen = _draw_lores(platform, screen, mask, effect, c)
-    # `when_any`'s work may close over constants only: a mix's per-machine clipping is an input
-    fixed = isinstance(quirks.clipping, bool)
-    clipping = quirks.clipping if fixed else None
-    own_clipping = None if fixed else quirks.clipping
-    if platform.planes > 1:
-        screen, collision = when_any(needs.second_plane, _draw_second_plane(clipping), (screen, collision),
-                                     (lores, own_clipping))
-    hires = _Sprite(fetched.at_i, n, jnp.where(c.hires, drawn, 0), c.vx & 127, c.vy & 63)
-    grid, hires_collision = when_any(needs.hires_sprite, _draw_hires(platform, clipping), (grid, jnp.bool_(False)),
-                                     (hires, own_clipping))
-    return screen, grid, jnp.where(c.hires, hires_collision, collision)
 
 
 def _draw_second_plane(clipping):
@@ -415,10 +469,11 @@ def _apply(platform: Platform, state: MachineState, kind, effects: dict, effect:
     x would cost more under vmap), the stack push, I, pc (wrapped at the memory size), timers,
     the screen, and the extension's fields."""
     lanes = jnp.arange(16, dtype=jnp.int32)
-    V = jnp.where(lanes < effect.load_count, c.window, c.V)
+    V = jnp.where(lanes == c.x, effect.vx, c.V)
+    loaded = c.window if effect.load_flags is None else jnp.where(effect.load_flags, c.flags, c.window)
+    V = jnp.where(lanes < effect.load_count, loaded, V)  # FX65, FX85: after Vx, which they leave
     if effect.v_lanes is not None:
         V = jnp.where(effect.v_lanes, effect.v_values, V)
-    V = jnp.where(lanes == c.x, effect.vx, V)
     V = jnp.where((lanes == 15) & sets(kind, effects, "vf"), effect.vf, V)
     pushing = (lanes == c.sp) & sets(kind, effects, "push")
     address_mask = platform.address_mask

@@ -55,7 +55,7 @@ def test_every_step_is_the_same_with_the_options(platform):
     rollout = _rollout(env, params)
     plain = jax.jit(rollout)(keys, actions)  # (final state, (obs, reward, terminated, truncated, info))
     # The platform's options and region analysis forced on: each distinct, non-plain set once
-    # (SUPER-CHIP's own are none, CHIP-8's and XO-CHIP's are region analysis).
+    # (every platform's own are region analysis today, so one set).
     option_sets = [env.compiler_options] if env.compiler_options else []
     option_sets += [o for o in ({**env.compiler_options, **REGION_ANALYSIS},) if o not in option_sets]
     for options in option_sets:

@@ -58,15 +58,17 @@ class Effect(NamedTuple):
     push: Optional[jax.Array] = None  # return address written to stack[sp] (default none)
     mem_data: Optional[jax.Array] = None  # (16,) bytes to write at I (default: the bytes there)
     mem_count: Optional[jax.Array] = None  # how many of mem_data to write (default 0)
-    load_count: Optional[jax.Array] = None  # load V0..V(count-1) from memory at I (default 0)
+    load_count: Optional[jax.Array] = None  # load V0..V(count-1) from memory at I (default 0), after vx
     delay_timer: Optional[jax.Array] = None  # new delay timer (default unchanged)
     sound_timer: Optional[jax.Array] = None  # new sound timer (default unchanged)
     rng: Optional[jax.Array] = None  # new xorshift32 state (default unchanged)
     key_wait: Optional[jax.Array] = None  # new FX0A progress (default unchanged)
     clear_planes: Optional[jax.Array] = None  # plane mask cleared (default 0; CHIP-8's one plane is 1)
     # SUPER-CHIP and XO-CHIP only; their defaults are None on CHIP-8, and `merge` skips them there:
+    load_flags: Optional[jax.Array] = None  # the load_count registers come from the flags, not memory
+    # XO-CHIP only:
     v_lanes: Optional[jax.Array] = None  # (16,) bool: registers loaded from v_values (default none)
-    v_values: Optional[jax.Array] = None  # (16,) values for the v_lanes (written before vx and vf)
+    v_values: Optional[jax.Array] = None  # (16,) values for the v_lanes (written after vx, before vf)
     scroll_x: Optional[jax.Array] = None  # scroll the selected planes right by this many pixels
     scroll_y: Optional[jax.Array] = None  # ... and down by this many (screen pixels; default 0)
     hires: Optional[jax.Array] = None  # new display mode (default unchanged)

@@ -64,9 +64,7 @@ def op_fx75(c: Context) -> Effect:
 
 def op_fx85(c: Context) -> Effect:
     """LD Vx, R: V0..Vx = flags[0..x]."""
-    lanes = jnp.arange(16, dtype=jnp.int32)
-    # vx is named too: the merged effect writes Vx after the loaded lanes and must not undo them.
-    return Effect(v_lanes=lanes <= c.x, v_values=c.flags, vx=c.flags[c.x])
+    return Effect(load_count=c.x + 1, load_flags=jnp.bool_(True))
 
 
 def _range(c: Context):
@@ -89,7 +87,7 @@ def op_5xy3(c: Context) -> Effect:
     """LOAD Vx..Vy: V[x +/- k] = memory[I + k]; I does not move."""
     lanes, in_range = _range(c)
     values = c.window[jnp.abs(lanes - c.x)]
-    return Effect(v_lanes=in_range, v_values=values, vx=c.window[0])
+    return Effect(v_lanes=in_range, v_values=values)
 
 
 def op_f000(c: Context) -> Effect:

@@ -43,5 +43,4 @@ def op_fx55(c: Context) -> Effect:
 
 def op_fx65(c: Context) -> Effect:
     """LD V0..Vx, [I]; I += x + 1 with memory_increment."""
-    # vx is named too: the effect writes Vx after the bulk load and must not undo it.
-    return Effect(load_count=c.x + 1, vx=c.window[c.x], i=_i_after_transfer(c))
+    return Effect(load_count=c.x + 1, i=_i_after_transfer(c))
