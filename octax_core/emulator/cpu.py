@@ -357,9 +357,9 @@ def _draw(platform: Platform, quirks: Quirks, state: MachineState, fetched: Fetc
     scroll, a hires clear, XO-CHIP's plane 2, the 128x64 grid) is rare work: it runs under one
     `when_any`, when some machine of the batch needs some of it, and inside that each part
     under its own (`_rare_work`). A CHIP-8 program run by SUPER-CHIP or XO-CHIP pays for one
-    predicate, one stacked input and one loop that does not run. An instruction draws, clears
-    or scrolls, never two of these, so their order is free: plane 1's draw goes first, straight
-    on the state's screen.
+    predicate, one packed input and one loop that does not run. An instruction draws, clears
+    or scrolls, never two of these, so their order is free: the rare work goes first, straight
+    on the state's surfaces, and plane 1's clear and draw after it.
     """
     c, n = fetched.context, fetched.fields.n
     if not platform.extended:
@@ -371,29 +371,29 @@ def _draw(platform: Platform, quirks: Quirks, state: MachineState, fetched: Fetc
     lores = _Sprite(fetched.at_i, n, jnp.where(c.hires, 0, drawn), c.vx & 63, c.vy & 31)
     patterns, height = _plane_patterns(lores, range(1))
     mask = display.sprite_mask(patterns, lores.x, lores.y, height, display.LORES, quirks.clipping)
-    collision = display.collides(state.screen[:1], mask)
-    if platform.planes > 1:  # plane 2's mask is zero here: `_draw_second_plane` draws it
-        mask = jnp.concatenate([mask, jnp.zeros_like(mask)])
-    screen = _draw_lores(platform, state.screen, mask, effect, c)
     needs = _needs(platform, c, effect, drawing)
     rare = _Rare(needs=sum(jnp.where(need, bit, 0) for need, bit in zip(needs, _NEEDS_BITS)),
                  hires=c.hires, clear_planes=effect.clear_planes, plane=c.plane, drawn=drawn,
                  scroll_x=effect.scroll_x, scroll_y=effect.scroll_y, n=n)
     # `when_any`'s work may close over constants only: a mix's per-machine clipping is an input
     fixed = isinstance(quirks.clipping, bool)
-    return when_any(needs.grid_change | needs.screen_scroll | needs.second_plane | needs.hires_sprite,
-                    _rare_work(platform, quirks.clipping if fixed else None),
-                    (screen, state.extension.grid, collision),
-                    (_pack(rare), c.vx, c.vy, fetched.at_i, None if fixed else quirks.clipping))
+    screen, grid, collision = when_any(
+        needs.grid_change | needs.screen_scroll | needs.second_plane | needs.hires_sprite,
+        _rare_work(platform, quirks.clipping if fixed else None), (state.screen, state.extension.grid, jnp.bool_(False)),
+        (_pack(rare), c.vx, c.vy, fetched.at_i, None if fixed else quirks.clipping))
+    collision = collision | display.collides(screen[:1], mask)
+    if platform.planes > 1:  # plane 2's mask is zero here: `_draw_second_plane` drew it
+        mask = jnp.concatenate([mask, jnp.zeros_like(mask)])
+    return _draw_lores(platform, screen, mask, effect, c), grid, collision
 
 
 def _rare_work(platform: Platform, clipping):
     """The rare work of an instruction, each part under its own `when_any` (one reduction gives
     their predicates, `gate.any_of_batch`): a hires scroll or clear, a lores scroll, XO-CHIP's
-    plane 2 sprite, a sprite on the grid. Operands (screen, grid, the collision: plane 1's, and
-    the grid's in hires); a no-op for a machine that needs none of it (a machine in hires that
-    draws nothing has no collision on either surface). `clipping` a constant, or None to read
-    the machine's own from the inputs (a mix of profiles)."""
+    plane 2 sprite, a sprite on the grid. Operands (screen, grid, collision), the collision
+    false on entry and, on the way out, plane 2's or the grid's (plane 1's is ORed in after);
+    a no-op for a machine that needs none of it. `clipping` a constant, or None to read the
+    machine's own from the inputs (a mix of profiles)."""
     def work(operands, inputs):
         (screen, grid, collision), (packed, x, y, at_i, own_clipping) = operands, inputs
         rare = _unpack(packed)
