@@ -150,7 +150,9 @@ def merge(kind, effects: dict, defaults: Effect) -> Effect:
             merged[field] = None
             continue
         setters = [(k, getattr(effect, field)) for k, effect in effects.items() if getattr(effect, field) is not None]
-        if jnp.ndim(default) == 0:
+        if not setters:  # no handler of this platform sets it (XO-CHIP's audio, on SUPER-CHIP)
+            value = default
+        elif jnp.ndim(default) == 0:
             value = default
             for handler_kind, candidate in setters:
                 value = jnp.where(kind == handler_kind, candidate, value)
