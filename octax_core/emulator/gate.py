@@ -12,7 +12,7 @@ bit, on a machine whose predicate is false. Then running it for the whole batch,
 it, changes nothing for any machine, and no select over the (large) operands is needed.
 
 The skip pays on a CPU, where the batch's work is the time. On a GPU the loop's predicate is read
-back to the host before each trip (a device-to-host sync, up to four gates an instruction), which cost
+back to the host before each trip (a device-to-host sync, one gate an instruction, four more inside it when it runs), which cost
 more than the work it skips: there the work simply runs for the whole batch, which the contract
 makes the same. `LOOPED_PLATFORMS` names where the gate loops; `jax.lax.platform_dependent`
 picks per platform when the program is lowered, so one traced program serves both.
@@ -101,8 +101,10 @@ def _at_most_once(pred, fn, operands, inputs):
     straight back (a whole screen per instruction, measured), where a loop's carry is updated
     in place, and when the loop does not run, nothing is copied or computed."""
     def body(carry):
-        _, operands = carry
-        return jnp.bool_(False), fn(operands, inputs)
+        again, operands = carry
+        # `again & False`, not a constant: under `shard_map` the predicate varies over the mesh,
+        # and a loop's carry must keep its type
+        return again & False, fn(operands, inputs)
 
     _, out = jax.lax.while_loop(lambda carry: carry[0], body, (jnp.asarray(pred, jnp.bool_), operands))
     return out

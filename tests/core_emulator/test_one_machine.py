@@ -275,3 +275,34 @@ def test_the_gpu_form_of_the_gates_plays_the_same_batch(name, monkeypatch):
         if jnp.issubdtype(a.dtype, jax.dtypes.prng_key):
             a, b = jax.random.key_data(a), jax.random.key_data(b)
         np.testing.assert_array_equal(np.asarray(a), np.asarray(b), err_msg=str(path[0]))
+
+
+def test_the_rare_work_crosses_into_its_gate_as_one_word():
+    """Every value each `cpu._Rare` field can take survives `_pack` and `_unpack` (the scrolls
+    signed), and the fields fit one uint32: the gate's inputs are that word, Vx, Vy and the bytes
+    at I, not a buffer per field."""
+    ranges = {"needs": range(16), "hires": range(2), "clear_planes": range(4), "plane": range(4),
+              "drawn": range(4), "scroll_x": (-4, 0, 4), "scroll_y": range(-15, 16), "n": range(16)}
+    assert tuple(ranges) == cpu._Rare._fields and sum(bits for bits, _ in cpu._RARE_BITS) <= 32
+    for field, values in ranges.items():
+        values = jnp.asarray(list(values), jnp.int32)
+        others = {name: jnp.full(values.shape, max(r), jnp.int32) for name, r in ranges.items() if name != field}
+        rare = cpu._Rare(**others, **{field: values})
+        unpacked = cpu._unpack(cpu._pack(rare))
+        for name in cpu._Rare._fields:
+            np.testing.assert_array_equal(getattr(unpacked, name), getattr(rare, name), err_msg=f"{field}: {name}")
+
+
+def test_an_instruction_has_a_gate_for_its_memory_write_and_one_for_its_rare_work():
+    """Every platform's memory write is gated (few instructions write); SUPER-CHIP and XO-CHIP's
+    rare work (scrolls, hires clears, plane 2, the grid's sprite) is one more gate at the
+    instruction's top level, with its parts inside it. (A gate per part cost each batch a loop,
+    a predicate and their inputs on every instruction.)"""
+    for name, gates in (("chip8", 1), ("schip", 2), ("xochip", 2)):
+        machine = octax_core.Machine(name)
+        states = jax.vmap(lambda k: machine.boot(b"\x12\x00", k))(jax.random.split(jax.random.key(0), 4))
+        instruction = jax.make_jaxpr(jax.vmap(lambda s, k: cpu.execute(machine.platform, machine.quirks, s, k)[0]))
+        eqns = instruction(states, jnp.zeros(4, jnp.uint32)).jaxpr.eqns
+        # `gate.when_any` under vmap: one batch reduction, then `platform_dependent` (a cond) over the loop
+        assert sum(e.primitive.name == "cond" for e in eqns) == gates, name
+        assert not any(e.primitive.name == "while" for e in eqns), name
