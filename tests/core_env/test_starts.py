@@ -108,21 +108,22 @@ def _loops(jaxpr) -> list[str]:
 @pytest.mark.parametrize("noop_max", [0, 30])
 def test_reset_and_autoreset_run_no_loop_whatever_noop_max(ticker, noop_max):
     """A reset is a draw and a reseed: no loop. An autoresetting step runs the frame loops (4
-    frames of 11 instructions) and the autoreset's gate (`gate.when_any`: a loop of zero trips or
-    one, no trip when no episode ended), never a no-op loop, however many no-ops a start may take."""
+    frames of 11 instructions, each with its memory-write gate) and the autoreset's gate
+    (`gate.when_any`: a loop of zero trips or one, no trip when no episode ended), never a no-op
+    loop, however many no-ops a start may take."""
     env, params, _ = ticker(noop_max, autoreset=True)
     reset = jax.make_jaxpr(jax.vmap(env.reset, in_axes=(0, None)))(jax.random.split(jax.random.key(0), 2), params)
     assert _loops(reset.jaxpr) == []
     _, state = env.reset(jax.random.key(0), params)
     step = jax.make_jaxpr(env.step)(jax.random.key(1), state, 1, params)
-    # the one frame loop (octax_core.emulator.frame): frames, and instructions within a frame;
-    # then the autoreset's gate
-    assert _loops(step.jaxpr) == ["while", "scan", "while"]
+    # the one frame loop (octax_core.emulator.frame): frames, instructions within a frame, and
+    # each instruction's memory-write gate (zero trips or one); then the autoreset's gate
+    assert _loops(step.jaxpr) == ["while", "scan", "while", "while"]
     # From 25 instructions a frame skip_idle (the default) runs the same loop over instruction chunks.
     env, params, _ = ticker(noop_max, autoreset=True, instructions_per_frame=100)
     _, state = env.reset(jax.random.key(0), params)
     step = jax.make_jaxpr(env.step)(jax.random.key(1), state, 1, params)
-    assert _loops(step.jaxpr) == ["while", "scan", "while"]
+    assert _loops(step.jaxpr) == ["while", "scan", "while", "while"]
 
 
 def test_autoreset_restarts_only_the_rows_asked_for(ticker):
