@@ -174,9 +174,8 @@ def sets(kind, effects: dict, field: str) -> jax.Array:
     return jnp.isin(kind, jnp.asarray(kinds, jnp.int32))
 
 
-def _defaults(platform: Platform, state: MachineState, c: Context) -> Effect:
-    """What an instruction leaves alone: pc moves on by 2, everything else stays as it is. A
-    field a platform's handlers never set has no default there (None), and `merge` skips it."""
+def _defaults(state: MachineState, c: Context) -> Effect:
+    """What an instruction leaves alone: pc moves on by 2, everything else stays as it is."""
     effect = Effect(pc=c.pc + 2, vx=c.vx, vf=jnp.int32(0), i=c.I, sp=c.sp, push=c.pc, mem_data=c.window,
                     mem_count=jnp.int32(0), load_count=jnp.int32(0), delay_timer=c.delay_timer,
                     sound_timer=state.sound_timer.astype(jnp.int32), rng=c.rng, key_wait=c.key_wait,
@@ -184,14 +183,11 @@ def _defaults(platform: Platform, state: MachineState, c: Context) -> Effect:
     if state.extension is None:
         return effect
     ext = state.extension
-    effect = effect._replace(
-        load_flags=jnp.bool_(False), scroll_x=jnp.int32(0), scroll_y=jnp.int32(0),
-        hires=c.hires, exited=ext.exited, flags=c.flags, plane=c.plane,
+    return effect._replace(
+        load_flags=jnp.bool_(False), v_lanes=jnp.zeros(16, jnp.bool_), v_values=c.V, scroll_x=jnp.int32(0),
+        scroll_y=jnp.int32(0), hires=c.hires, exited=ext.exited, flags=c.flags, plane=c.plane,
         audio_pattern=ext.audio_pattern.astype(jnp.int32), pitch=ext.pitch.astype(jnp.int32),
     )
-    if platform.level < 2:
-        return effect
-    return effect._replace(v_lanes=jnp.zeros(16, jnp.bool_), v_values=c.V)
 
 
 def execute(platform: Platform, quirks: Quirks, state: MachineState, keys: jax.Array, stalled=None):
@@ -217,7 +213,7 @@ def execute(platform: Platform, quirks: Quirks, state: MachineState, keys: jax.A
     # version alive (a read of the old memory after the write cost a whole 64 KiB copy per
     # instruction on XO-CHIP, measured).
     effects = {k: handler(c) for k, handler in handlers(platform).items()}
-    defaults = _defaults(platform, state, c)
+    defaults = _defaults(state, c)
     before_drawing = merge(kind, effects, defaults)  # all but DXYN's VF, which needs the collision
     written = _write_memory(platform, state.memory, before_drawing, c)
     screen, grid, collision = _draw(platform, quirks, state, fetched, kind == Kind.DRW, before_drawing)

@@ -66,7 +66,6 @@ class Effect(NamedTuple):
     clear_planes: Optional[jax.Array] = None  # plane mask cleared (default 0; CHIP-8's one plane is 1)
     # SUPER-CHIP and XO-CHIP only; their defaults are None on CHIP-8, and `merge` skips them there:
     load_flags: Optional[jax.Array] = None  # the load_count registers come from the flags, not memory
-    # XO-CHIP only:
     v_lanes: Optional[jax.Array] = None  # (16,) bool: registers loaded from v_values (default none)
     v_values: Optional[jax.Array] = None  # (16,) values for the v_lanes (written after vx, before vf)
     scroll_x: Optional[jax.Array] = None  # scroll the selected planes right by this many pixels
