@@ -23,7 +23,7 @@ import jax.numpy as jnp
 import numpy as np
 
 from octax_core.emulator.decode import Decoded, decode
-from octax_core.emulator.gate import any_of_batch, when_any
+from octax_core.emulator.gate import any_of_batch, when_any, where_looped
 from octax_core.emulator.opcodes import LEVELS, OPCODES, Kind
 from octax_core.emulator.ops import Context, Effect, alu, display, extended, flow, keys, memory, timers
 from octax_core.emulator.platforms import Platform
@@ -369,6 +369,18 @@ def _draw(platform: Platform, quirks: Quirks, state: MachineState, fetched: Fetc
     predicate, one packed input and one loop that does not run. An instruction draws, clears
     or scrolls, never two of these, so their order is free: the rare work goes first, straight
     on the state's surfaces, and plane 1's clear and draw after it.
+
+    Where the gate is a loop (a CPU), plane 1's collision is read off the state's screen, before
+    the rare work, and enters the gate as its collision operand. It is the same as after it: a
+    machine whose mask draws on plane 1 is drawing a lores sprite, and the rare work leaves plane
+    1 of such a machine as it is (it draws plane 2 at most). The order matters to XLA:CPU: read
+    after the loop, the screen had two readers, the collision and plane 1's draw, that XLA could
+    not order before the draw's in-place write, and it copied the screen before the loop on every
+    instruction (3 us with one thread and 14-19 with JAX's two at N = 512; without the copy
+    SUPER-CHIP and XO-CHIP run 1.3-1.7x faster there). CHIP-8 reads it the same way, before its
+    draw. Where the gate always runs (a GPU) there is no loop to copy for, and reading it after the
+    rare work measured 8-25% faster on XO-CHIP at N = 8,192 (`gate.where_looped` picks; see
+    docs/machine.md).
     """
     c, n = fetched.context, fetched.fields.n
     if not platform.extended:
@@ -386,11 +398,18 @@ def _draw(platform: Platform, quirks: Quirks, state: MachineState, fetched: Fetc
                  scroll_x=effect.scroll_x, scroll_y=effect.scroll_y, n=n)
     # `when_any`'s work may close over constants only: a mix's per-machine clipping is an input
     fixed = isinstance(quirks.clipping, bool)
-    screen, grid, collision = when_any(
-        needs.grid_change | needs.screen_scroll | needs.second_plane | needs.hires_sprite,
-        _rare_work(platform, quirks.clipping if fixed else None), (state.screen, state.extension.grid, jnp.bool_(False)),
-        (_pack(rare), c.vx, c.vy, fetched.at_i, None if fixed else quirks.clipping))
-    collision = collision | display.collides(screen[:1], mask)
+    needed = needs.grid_change | needs.screen_scroll | needs.second_plane | needs.hires_sprite
+    work = _rare_work(platform, quirks.clipping if fixed else None)
+    inputs = (_pack(rare), c.vx, c.vy, fetched.at_i, None if fixed else quirks.clipping)
+
+    def collision_first(screen, grid):  # where the gate loops: plane 1's collision enters it
+        return when_any(needed, work, (screen, grid, display.collides(screen[:1], mask)), inputs)
+
+    def collision_after(screen, grid):  # where it always runs: ORed in after it
+        screen, grid, collision = when_any(needed, work, (screen, grid, jnp.bool_(False)), inputs)
+        return screen, grid, collision | display.collides(screen[:1], mask)
+
+    screen, grid, collision = where_looped(collision_first, collision_after, state.screen, state.extension.grid)
     if platform.planes > 1:  # plane 2's mask is zero here: `_draw_second_plane` drew it
         mask = jnp.concatenate([mask, jnp.zeros_like(mask)])
     return _draw_lores(platform, screen, mask, effect, c), grid, collision
@@ -400,9 +419,10 @@ def _rare_work(platform: Platform, clipping):
     """The rare work of an instruction, each part under its own `when_any` (one reduction gives
     their predicates, `gate.any_of_batch`): a hires scroll or clear, a lores scroll, XO-CHIP's
     plane 2 sprite, a sprite on the grid. Operands (screen, grid, collision), the collision
-    false on entry and, on the way out, plane 2's or the grid's (plane 1's is ORed in after);
-    a no-op for a machine that needs none of it. `clipping` a constant, or None to read the
-    machine's own from the inputs (a mix of profiles)."""
+    plane 1's or false on entry (`_draw`) and, on the way out, plane 2's ORed in, or the grid's
+    on a machine in hires (whose plane 1 collision is false: its lores mask is zero); a no-op for
+    a machine that needs none of it. `clipping` a constant, or None to read the machine's own from the
+    inputs (a mix of profiles)."""
     def work(operands, inputs):
         (screen, grid, collision), (packed, x, y, at_i, own_clipping) = operands, inputs
         rare = _unpack(packed)

@@ -15,7 +15,9 @@ The skip pays on a CPU, where the batch's work is the time. On a GPU the loop's 
 back to the host before each trip (a device-to-host sync; an instruction has two gates, the memory
 write and the rare work, and four more inside the second), which cost more than the work it
 skips: there the work simply runs for the whole batch, which the contract makes the same. `LOOPED_PLATFORMS` names where the gate loops; `jax.lax.platform_dependent`
-picks per platform when the program is lowered, so one traced program serves both.
+picks per platform when the program is lowered, so one traced program serves both; `where_looped`
+makes the same choice for work around a gate (`cpu._draw` reads plane 1's collision before the
+rare work where the gate loops, after it elsewhere).
 """
 
 from __future__ import annotations
@@ -80,18 +82,20 @@ def any_of_batch(*preds: jax.Array) -> tuple[jax.Array, ...]:
     return each(tuple(jnp.asarray(p, jnp.bool_) for p in preds))
 
 
+def where_looped(looped: Callable, always: Callable, *args):
+    """`looped(*args)` in a program lowered for one of `LOOPED_PLATFORMS`, `always(*args)`
+    elsewhere: for work around a gate whose best form depends on whether the gate is a loop (the
+    two must give the same result; `jax.lax.platform_dependent` picks when the program is
+    lowered, so one traced program serves every platform)."""
+    if not LOOPED_PLATFORMS:
+        return always(*args)
+    return jax.lax.platform_dependent(*args, default=always, **{platform: looped for platform in LOOPED_PLATFORMS})
+
+
 def _per_platform(pred, fn, operands, inputs):
     """The loop of `_at_most_once` on `LOOPED_PLATFORMS`, `fn` unconditionally elsewhere."""
-    def always(pred, operands, inputs):
-        return fn(operands, inputs)
-
-    def looped(pred, operands, inputs):
-        return _at_most_once(pred, fn, operands, inputs)
-
-    if not LOOPED_PLATFORMS:
-        return always(pred, operands, inputs)
-    return jax.lax.platform_dependent(pred, operands, inputs, default=always,
-                                      **{platform: looped for platform in LOOPED_PLATFORMS})
+    return where_looped(lambda pred, operands, inputs: _at_most_once(pred, fn, operands, inputs),
+                        lambda pred, operands, inputs: fn(operands, inputs), pred, operands, inputs)
 
 
 def _at_most_once(pred, fn, operands, inputs):

@@ -306,3 +306,38 @@ def test_an_instruction_has_a_gate_for_its_memory_write_and_one_for_its_rare_wor
         # `gate.when_any` under vmap: one batch reduction, then `platform_dependent` (a cond) over the loop
         assert sum(e.primitive.name == "cond" for e in eqns) == gates, name
         assert not any(e.primitive.name == "while" for e in eqns), name
+
+
+def _loop_bodies(hlo_text: str) -> dict[str, str]:
+    """The compiled program's `while` bodies: {name: text}."""
+    import re
+
+    computations = {match.group(1): match.group(2) for match in
+                    re.finditer(r"^(?:ENTRY )?%(\S+) .*?\{\n(.*?)\n\}", hlo_text, re.S | re.M)}
+    return {name: computations[name] for name in set(re.findall(r"body=%([\w.\-]+)", hlo_text))}
+
+
+@pytest.mark.parametrize("name", ["schip", "xochip"])
+def test_the_instruction_loop_copies_no_screen(name):
+    """On SUPER-CHIP and XO-CHIP the loops that run instructions (the instruction loop and the
+    frame loop around it: the bodies with a loop inside) never copy the screen. The rare work's
+    gate updates the screen in place, then plane 1's draw; with plane 1's collision read after
+    the gate, XLA could not order that read before the draw's in-place write and copied the whole
+    screen before the gate on every instruction (see `cpu._draw`). The gated bodies themselves
+    (a scroll reads the surface it rewrites) may copy. CHIP-8 is left out: jitted like this,
+    without the benchmarks' scan around it, XLA copies its drawn screen once an instruction.
+    Reading its collision off the drawn screen instead removes that copy, but ran 15% slower on
+    a 15-ipf program at N = 512 in the scan, where XLA copies nothing either way (docs/machine.md)."""
+    import re
+
+    machine = octax_core.Machine(name, quirks="chip8", instructions_per_frame=11)
+    states = jax.vmap(lambda k: machine.boot(b"\x00\xe0\x12\x00", k))(jax.random.split(jax.random.key(0), 8))
+    host = jax.devices("cpu")[0]  # XLA:CPU's program, also on a host with an accelerator
+    states, keys = jax.device_put((states, jnp.zeros(8, jnp.uint32)), host)
+    run = jax.jit(jax.vmap(lambda s, k: machine.run_frames(s, k, 4)), compiler_options=machine.compiler_options)
+    text = run.lower(states, keys).compile().as_text()
+    screen = re.escape("u32[" + ",".join(map(str, states.screen.shape)) + "]")
+    looping = {body: code for body, code in _loop_bodies(text).items() if " while(" in code}
+    assert looping  # the frame loop and the instruction loop at least
+    for body, code in looping.items():
+        assert not re.search(rf"= {screen}\S* copy\(", code), f"{name}: {body} copies the screen"
