@@ -378,9 +378,9 @@ def _draw(platform: Platform, quirks: Quirks, state: MachineState, fetched: Fetc
     not order before the draw's in-place write, and it copied the screen before the loop on every
     instruction (3 us with one thread and 14-19 with JAX's two at N = 512; without the copy
     SUPER-CHIP and XO-CHIP run 1.3-1.7x faster there). CHIP-8 reads it the same way, before its
-    draw. Where the gate always runs (a GPU) there is no loop to copy for, and reading it after the
-    rare work measured 8-25% faster on XO-CHIP at N = 8,192 (`gate.where_looped` picks; see
-    docs/machine.md).
+    draw. Where the gate always runs (a GPU) there is no loop to copy for, and reading it first
+    made XO-CHIP 8-23% slower at N = 8,192 on an H100, so there it is read after the rare work
+    (`gate.where_looped` picks; see docs/machine.md).
     """
     c, n = fetched.context, fetched.fields.n
     if not platform.extended:

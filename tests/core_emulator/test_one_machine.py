@@ -227,6 +227,22 @@ def test_off_the_looped_platforms_the_work_always_runs(monkeypatch):
     np.testing.assert_array_equal(kept(pred, x, jnp.full(6, 7, jnp.int32)), np.where(pred, x + 7, x))
 
 
+def test_where_looped_picks_by_the_platform_the_program_is_lowered_for(monkeypatch):
+    """`where_looped` runs its first function in a program for a platform where the gates loop,
+    its second elsewhere (the two differ here on purpose, to show which ran)."""
+    from octax_core.emulator import gate
+
+    def program():
+        return jax.jit(lambda x: gate.where_looped(lambda x: x + 1, lambda x: x + 2, x))
+
+    looped = jax.default_backend() in gate.LOOPED_PLATFORMS
+    assert int(program()(jnp.int32(0))) == (1 if looped else 2)
+    on_host = program()(jax.device_put(jnp.int32(0), jax.devices("cpu")[0]))
+    assert int(on_host) == (1 if "cpu" in gate.LOOPED_PLATFORMS else 2)
+    monkeypatch.setattr(gate, "LOOPED_PLATFORMS", ())
+    assert int(program()(jnp.int32(0))) == 2
+
+
 # SUPER-CHIP and XO-CHIP archive programs that draw in hires, scroll and switch modes
 GATED_PROGRAMS = ("sens8tion", "superOctoTrackXO",  # SUPER-CHIP, XO-CHIP; two more in make test-slow
                   pytest.param("sweetcopter", marks=pytest.mark.slow), pytest.param("OctoPartyMix", marks=pytest.mark.slow))
