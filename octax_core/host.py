@@ -4,8 +4,8 @@ XLA:CPU runs a step as a sequence of small kernels ("thunks") on a pool of one t
 handing ready kernels and the halves of large loops to the other threads. An emulator step is
 many kernels of a few microseconds each, so on a host with few cores the handoffs can cost more
 than the work they share: on the 2-core CI machine, with a one-thread pool, the same programs ran
-1.2x (CHIP-8, N = 64) to 1.9x (XO-CHIP, N = 64) faster, and about as fast at N = 512
-(docs/machine.md, the same-program table).
+1.2x (CHIP-8, N = 64) to 1.5-1.8x (XO-CHIP, N = 64) faster, and at N = 512 5-30% slower (every
+platform gains from the second thread there; docs/machine.md, the same-program tables).
 Other work gains from the pool (the octax package's env ran 30% slower with one thread), so the
 pool keeps JAX's default unless asked.
 
