@@ -421,8 +421,8 @@ def _rare_work(platform: Platform, clipping):
     plane 2 sprite, a sprite on the grid. Operands (screen, grid, collision), the collision
     plane 1's or false on entry (`_draw`) and, on the way out, plane 2's ORed in, or the grid's
     on a machine in hires (whose plane 1 collision is false: its lores mask is zero); a no-op for
-    a machine that needs none of it. `clipping` a constant, or None to read the machine's own from the
-    inputs (a mix of profiles)."""
+    a machine that needs none of it. `clipping` a constant, or None to read the machine's own
+    from the inputs (a mix of profiles)."""
     def work(operands, inputs):
         (screen, grid, collision), (packed, x, y, at_i, own_clipping) = operands, inputs
         rare = _unpack(packed)

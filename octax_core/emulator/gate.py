@@ -14,10 +14,11 @@ it, changes nothing for any machine, and no select over the (large) operands is 
 The skip pays on a CPU, where the batch's work is the time. On a GPU the loop's predicate is read
 back to the host before each trip (a device-to-host sync; an instruction has two gates, the memory
 write and the rare work, and four more inside the second), which cost more than the work it
-skips: there the work simply runs for the whole batch, which the contract makes the same. `LOOPED_PLATFORMS` names where the gate loops; `jax.lax.platform_dependent`
-picks per platform when the program is lowered, so one traced program serves both; `where_looped`
-makes the same choice for work around a gate (`cpu._draw` reads plane 1's collision before the
-rare work where the gate loops, after it elsewhere).
+skips: there the work simply runs for the whole batch, which the contract makes the same.
+`LOOPED_PLATFORMS` names where the gate loops; `jax.lax.platform_dependent` picks per platform
+when the program is lowered, so one traced program serves both; `where_looped` makes the same
+choice for work around a gate (`cpu._draw` reads plane 1's collision before the rare work where
+the gate loops, after it elsewhere).
 """
 
 from __future__ import annotations
