@@ -230,7 +230,7 @@ def write_page(measurements: dict) -> str:
         "# The archive suite: a gallery",
         "",
         f"{len(games)} games of the [Chip8 Community Archive](https://github.com/JohnEarnest/chip8Archive) "
-        f"(commit {ARCHIVE_COMMIT}), every one CC0 and shipped inside the package: `pip install octax-gym` "
+        f"(commit {ARCHIVE_COMMIT}), every one CC0 and shipped inside the package: installing it ([install.md](install.md)) "
         "and `gymnasium.make(\"octax/<id>-v0\")` need no ROM download. "
         "`octax_core.list_games(suite=\"archive\")` lists them; each game's module in "
         "`octax_core/env/games/archive/` documents its keys, start-up, score, lives and end, read from the "
@@ -271,6 +271,27 @@ def write_page(measurements: dict) -> str:
     return "\n".join(lines)
 
 
+# The README's picture: the third preview frame of each, 4 x 2, on the games' own palettes.
+STRIP_GAMES = ("Br8kout", "SuperOctogon", "Rockto", "FlutterBy", "Sw8Copter", "Carbon8", "Masquer8", "Snek")
+
+
+def write_strip(folder: Path = None, games=STRIP_GAMES, gap: int = 4) -> Path:
+    """gallery/strip.png from the saved previews (each is 4 frames of 256 x 128 with `gap` between)."""
+    import cv2
+    import numpy as np
+
+    folder = FOLDER if folder is None else folder
+    tiles = [cv2.imread(str(folder / f"{game}.png"))[:, 2 * (256 + gap):3 * 256 + 2 * gap] for game in games]
+    grey = lambda h, w: np.full((h, w, 3), 40, np.uint8)
+    rows = []
+    for r in range(2):
+        row = tiles[4 * r:4 * r + 4]
+        rows.append(np.concatenate(sum(([t, grey(128, gap)] for t in row), [])[:-1], axis=1))
+    strip = np.concatenate([rows[0], grey(gap, rows[0].shape[1]), rows[1]], axis=0)
+    cv2.imwrite(str(folder / "strip.png"), strip)
+    return folder / "strip.png"
+
+
 def main(argv=None) -> int:
     import cv2
 
@@ -293,7 +314,7 @@ def main(argv=None) -> int:
         print(f"not measured yet: {missing}", file=sys.stderr)
         return 1
     PAGE.write_text(write_page(saved))
-    print(f"wrote {PAGE} ({len(games)} games)")
+    print(f"wrote {PAGE} ({len(games)} games) and {write_strip()}")
     return 0
 
 
