@@ -28,12 +28,14 @@ def add_commands(commands: argparse._SubParsersAction) -> None:
                     "screen in the game's palette and takes the keyboard (Octo's layout: 1234/QWER/ASDF/ZXCV). "
                     "Needs the play extra: " + PLAY_HINT + ". See docs/play.md.")
     play.add_argument("game", metavar="GAME", help="game id (Brix) or Gymnasium id; two-player games too (Duel)")
-    play.add_argument("--port", type=int, default=0, metavar="N", help="port (default: a free one)")
+    play.add_argument("--port", type=int, default=0, metavar="N", help="port, 0..65535 (default 0: a free one)")
     play.add_argument("--host", default=None, metavar="H",
-                      help="address to bind (default 127.0.0.1, this machine only; anything else is reachable "
-                           "by others on your network: a warning is printed)")
+                      help="address to bind (default 127.0.0.1, this machine only; a loopback address keeps the "
+                           "Host check against DNS rebinding; anything else is reachable by others on your "
+                           "network and accepts any Host: a warning is printed)")
     play.add_argument("--open", action="store_true", help="open the page in the default browser")
-    play.add_argument("--seed", type=int, default=0, metavar="S", help="episode e is seeded S + e (default 0)")
+    play.add_argument("--seed", type=int, default=0, metavar="S",
+                      help="S in 0..4294967295; episode e is seeded (S + e) mod 2**32 (default 0)")
     play.add_argument("--agent", type=Path, metavar="PATH",
                       help="a trained agent: params.msgpack from the JAX examples, or a Stable-Baselines3 zip")
     play.add_argument("--players", metavar="P[,P]",
@@ -49,7 +51,19 @@ def add_commands(commands: argparse._SubParsersAction) -> None:
     play.set_defaults(func=_cmd_play)
 
 
+def _check_port_and_seed(args: argparse.Namespace) -> None:
+    """Refuses, before anything is compiled, a port the socket and a seed the env would refuse later."""
+    from octax_gym.compiled_step import MAX_SEED
+
+    if not 0 <= args.port <= 65535:
+        raise ValueError(f"--port must be in 0..65535 (0: a free port), got {args.port}")
+    if not 0 <= args.seed < MAX_SEED:
+        raise ValueError(f"--seed must be in 0..{MAX_SEED - 1} (the env's seeds are uint32; episode e is "
+                         f"seeded (S + e) mod 2**32), got {args.seed}")
+
+
 def _cmd_play(args: argparse.Namespace) -> int:
+    _check_port_and_seed(args)
     try:
         import aiohttp  # noqa: F401
     except ImportError as exc:
@@ -57,6 +71,7 @@ def _cmd_play(args: argparse.Namespace) -> int:
     import logging
 
     from octax_gym.game_names import resolve_spec
+    from octax_gym.play.hosts import is_loopback
     from octax_gym.play.server import PlayServer
     from octax_gym.play.session import Session, is_two_player
 
@@ -89,10 +104,10 @@ def _cmd_play(args: argparse.Namespace) -> int:
     print(f"compiling {spec.id} ...", file=sys.stderr)
     session = Session(spec.id, seed=args.seed, agent=agent, players=players, recorder=recorder, **env_options)
     host = args.host or "127.0.0.1"
-    if args.host is not None and args.host not in ("127.0.0.1", "localhost", "::1"):
+    if not is_loopback(host):  # the server then accepts any Host header: it must, to be reached by name
         print(f"octax-gym play: warning: binding {args.host}: anyone who can reach this address can play and "
               "see the game; the page has no login", file=sys.stderr)
-    server = PlayServer(session, host=host, allow_any_host=args.host is not None)
+    server = PlayServer(session, host=host)
 
     def started(url: str) -> None:
         print(f"octax-gym play: {spec.id} at {url}  (Ctrl-C to stop)", flush=True)

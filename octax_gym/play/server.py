@@ -4,20 +4,25 @@
     server.run(port=0)                        # blocks; prints http://127.0.0.1:PORT/
     handle = start_in_thread(Session("Brix")) # for tests and notebooks: handle.url, handle.stop()
 
-The env steps here, on the server's clock: at speed 1, one step every frames_per_step / 60 s (15
-steps, 60 frames a second at 4 frames a step); the page only draws the frames it is sent and sends
-keys. One page plays at a time: a second one takes over and the first is told so and closed.
+The env steps here, on the server's one clock (a task started with the server, whatever the pages
+do): at speed 1, one step every frames_per_step / 60 s (15 steps, 60 frames a second at 4 frames a
+step); the page only draws the frames it is sent and sends keys. One page plays at a time: a second
+one takes over (the seat changes hands in one statement, so pages arriving together cannot each
+think they hold it) and the first is told so and closed.
 
-Security: the server binds 127.0.0.1 unless told otherwise; it answers only requests whose Host is
-its own address (no DNS rebinding), accepts a WebSocket only from a page of its own origin, serves
-only `/`, the files in `static/` and `/ws`, and refuses and logs any message that breaks the
-protocol (`octax_gym.play.protocol`) without stopping.
+Security: the server binds 127.0.0.1 unless told otherwise; on any loopback address it answers only
+requests whose Host is its own address (no DNS rebinding: `octax_gym.play.hosts`), accepts a
+WebSocket only from a page of its own origin, serves only `/`, the files in `static/` and `/ws`,
+and refuses and logs any message that breaks the protocol (`octax_gym.play.protocol`) without
+stopping. A connection that is not the game's WebSocket is closed after a few seconds and past a
+cap new ones are refused (`octax_gym.play.connections`).
 """
 
 from __future__ import annotations
 
 import asyncio
 import collections
+import contextlib
 import json
 import logging
 import signal
@@ -28,7 +33,8 @@ from typing import Optional
 
 from aiohttp import WSMsgType, web
 
-from octax_gym.play import protocol
+from octax_gym.play import hosts, protocol
+from octax_gym.play.connections import MAX_CONNECTIONS, REQUEST_TIMEOUT, ConnectionGuard, GuardedRunner
 from octax_gym.play.session import Session
 from octax_gym.vector import FRAMES_PER_SECOND
 
@@ -36,7 +42,6 @@ log = logging.getLogger("octax_gym.play")
 STATIC = Path(__file__).parent / "static"
 STATIC_FILES = {"play.js": "text/javascript", "play.css": "text/css"}
 WS_MAX_BYTES = 64 * 1024   # aiohttp closes the connection past this (code 1009); protocol's own limit is lower
-LOOPBACK = ("127.0.0.1", "localhost", "[::1]", "::1")
 
 
 class PlayServer:
@@ -44,21 +49,28 @@ class PlayServer:
 
     Args:
         session: the game.
-        host: the address to bind (default 127.0.0.1, this machine only).
-        allow_any_host: accept any Host header (when bound beyond loopback with --host).
+        host: the address to bind (default 127.0.0.1, this machine only). Any loopback address
+            keeps the Host check on; only a bind beyond loopback accepts any Host header (whoever
+            can reach it can play: the command line warns).
+        request_timeout: seconds a connection that is not the game's WebSocket stays open.
+        max_connections: connections open at once; past it new ones are refused (503).
     """
 
-    def __init__(self, session: Session, *, host: str = "127.0.0.1", allow_any_host: bool = False):
+    def __init__(self, session: Session, *, host: str = "127.0.0.1", request_timeout: float = REQUEST_TIMEOUT,
+                 max_connections: int = MAX_CONNECTIONS):
         self.session = session
         self.host = host
-        self.allow_any_host = allow_any_host
+        self.allow_any_host = not hosts.is_loopback(host)
+        self.guard = ConnectionGuard(request_timeout=request_timeout, max_connections=max_connections,
+                                     report=self._refuse)
         self.port: Optional[int] = None
         self.paused = False
         self.speed = 1.0
         self.refused: collections.deque[str] = collections.deque(maxlen=1000)  # why, for tests and tools
         self.connections = 0
-        self._ws: Optional[web.WebSocketResponse] = None
-        self._wake = None
+        self._ws: Optional[web.WebSocketResponse] = None  # the page holding the seat
+        self._wake: Optional[asyncio.Event] = None        # set: the clock looks again at once
+        self._clock_task: Optional[asyncio.Task] = None
         self.app = web.Application(middlewares=[self._guard], client_max_size=1024)
         self.app.router.add_get("/", self._index)
         self.app.router.add_get("/static/{name}", self._static)
@@ -68,12 +80,7 @@ class PlayServer:
     # --- HTTP ------------------------------------------------------------------------------
 
     def allowed_host(self, host: Optional[str]) -> bool:
-        if self.allow_any_host:
-            return True
-        if not host or self.port is None:
-            return False
-        name, _, port = host.rpartition(":")
-        return port == str(self.port) and name in LOOPBACK + (self.host,)
+        return self.allow_any_host or hosts.answers(host, bind=self.host, port=self.port)
 
     @web.middleware
     async def _guard(self, request: web.Request, handler):
@@ -109,21 +116,20 @@ class PlayServer:
             return web.Response(status=403, text="forbidden origin\n")
         ws = web.WebSocketResponse(max_msg_size=WS_MAX_BYTES, heartbeat=30)
         await ws.prepare(request)
-        if self._ws is not None and not self._ws.closed:
-            old = self._ws
-            await self._send(old, {"type": "error", "message": "another page took over the game"})
-            await old.close(code=4000, message=b"another page took over")
-        self._ws = ws
-        self.connections += 1
-        limit = protocol.RateLimit()
+        self.guard.keep(request.transport)
         session = self.session
         await self._send(ws, session.hello())
         await self._send(ws, self.state())
         await self._send(ws, session.message())
-        self._wake = asyncio.Event()
-        clock = asyncio.create_task(self._clock(ws))
+        old, self._ws = self._ws, ws  # the seat, taken in one statement: nothing awaited in between
+        self.connections += 1
+        self._wake.set()
+        limit = protocol.RateLimit()
         last_error = 0.0
         try:
+            if old is not None and not old.closed:
+                await self._send(old, {"type": "error", "message": "another page took over the game"})
+                await old.close(code=4000, message=b"another page took over")
             async for msg in ws:
                 if msg.type == WSMsgType.ERROR:
                     exc = ws.exception()
@@ -150,7 +156,6 @@ class PlayServer:
                         last_error = now
                         await self._send(ws, {"type": "error", "message": str(exc)})
         finally:
-            clock.cancel()
             if self._ws is ws:
                 self._ws = None
                 session.held.clear()
@@ -178,13 +183,16 @@ class PlayServer:
         await self._send(ws, self.state())
         self._wake.set()
 
-    async def _clock(self, ws: web.WebSocketResponse) -> None:
-        """Steps the game on time: one step every frames_per_step / 60 / speed seconds."""
+    async def _clock(self) -> None:
+        """Steps the game on time for the page holding the seat: one step every frames_per_step /
+        60 / speed seconds. One task per server, started with it: however many pages connect, at
+        whatever moments, the game has this one clock."""
         loop = asyncio.get_running_loop()
         next_tick = loop.time()
-        while not ws.closed:
+        while True:
+            ws = self._ws
             period = self.session.frames_per_step / FRAMES_PER_SECOND / self.speed
-            if self.paused or self.session.done:
+            if ws is None or ws.closed or self.paused or self.session.done:
                 self._wake.clear()
                 try:
                     await asyncio.wait_for(self._wake.wait(), timeout=0.25)
@@ -224,17 +232,26 @@ class PlayServer:
         log.warning("refused: %s", why)
 
     async def _on_shutdown(self, app: web.Application) -> None:
+        if self._clock_task is not None:
+            self._clock_task.cancel()
+            with contextlib.suppress(asyncio.CancelledError):
+                await self._clock_task
+            self._clock_task = None
         if self._ws is not None:
             await self._ws.close(code=1001, message=b"server shutting down")
 
     # --- running -----------------------------------------------------------------------------
 
     async def start(self, port: int = 0) -> web.AppRunner:
-        runner = web.AppRunner(self.app, access_log=None, handle_signals=False)
+        if not (isinstance(port, int) and 0 <= port <= 65535):
+            raise ValueError(f"port must be in 0..65535 (0: a free port), got {port!r}")
+        runner = GuardedRunner(self.app, self.guard, access_log=None, handle_signals=False)
         await runner.setup()
         site = web.TCPSite(runner, self.host, port)
         await site.start()
         self.port = site._server.sockets[0].getsockname()[1]
+        self._wake = asyncio.Event()
+        self._clock_task = asyncio.create_task(self._clock())
         return runner
 
     @property
@@ -271,17 +288,26 @@ class ServerThread:
         self.loop = asyncio.new_event_loop()
         ready = threading.Event()
         self._runner = None
+        failed: list[BaseException] = []
 
         def main():
             asyncio.set_event_loop(self.loop)
-            self._runner = self.loop.run_until_complete(server.start(port))
-            ready.set()
+            try:
+                self._runner = self.loop.run_until_complete(server.start(port))
+            except BaseException as exc:  # a bad port, an address in use: raised in the caller's thread
+                failed.append(exc)
+                self.loop.close()
+                return
+            finally:
+                ready.set()
             self.loop.run_forever()
 
         self.thread = threading.Thread(target=main, name="octax-play-server", daemon=True)
         self.thread.start()
         if not ready.wait(60):
             raise RuntimeError("the play server did not start")
+        if failed:
+            raise failed[0]
 
     @property
     def url(self) -> str:

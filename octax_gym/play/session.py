@@ -5,8 +5,10 @@ The server (`octax_gym.play.server`) calls `reset()` and `step()` on its clock; 
 synchronous and knows nothing of the web. A step's frames are sent as palette indices (0 dark, 1
 lit, 2 and 3 XO-CHIP's other planes), which the page draws in the game's palette.
 
-Episode e (from 0) of a session seeded s is reset with seed s + e, exactly as
-`OctaxEnv.reset(seed=s + e)` resets: the same seed and the actions the server logs replay it.
+Episode e (from 0) of a session seeded s is reset with seed (s + e) mod 2**32, exactly as
+`OctaxEnv.reset(seed=...)` resets with that seed: the seed (each frame message carries it) and the
+actions the server logs replay it. The env takes seeds 0..2**32 - 1 (they become uint32 PRNG seeds),
+and a session may play any number of episodes, so the count wraps instead of running off the end.
 """
 
 from __future__ import annotations
@@ -22,6 +24,7 @@ import numpy as np
 
 from octax_core.env.games import list_games
 from octax_gym import render
+from octax_gym.compiled_step import MAX_SEED
 from octax_gym.game_names import resolve_spec
 from octax_gym.multi_vector import MultiAgentVectorEnv
 from octax_gym.vector import FRAMES_PER_SECOND, OctaxVectorEnv
@@ -41,6 +44,18 @@ def is_two_player(game: Any) -> bool:
     return resolve_spec(game).id in list_games(players=2)
 
 
+def check_seed(seed: Any) -> int:
+    """The seed as an int, or a ValueError naming the range the env takes (uint32 PRNG seeds)."""
+    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or not 0 <= seed < MAX_SEED:
+        raise ValueError(f"seed must be an int in 0..{MAX_SEED - 1} (the env's seeds are uint32), got {seed!r}")
+    return int(seed)
+
+
+def episode_seed(seed: int, episode: int) -> int:
+    """Episode `episode`'s reset seed in a session seeded `seed`: seed + episode, wrapped into the env's range."""
+    return (seed + episode) % MAX_SEED
+
+
 @dataclasses.dataclass
 class StepRecord:
     """What one step was: its episode, seed and step number, the actions of each seat, and the
@@ -58,7 +73,7 @@ class Session:
 
     Args:
         game: a game id ("Brix", "Duel"), Gymnasium id, any case.
-        seed: the first episode's seed; episode e is seeded seed + e.
+        seed: the first episode's seed, 0..2**32 - 1; episode e is seeded (seed + e) mod 2**32.
         agent: a function of one seat's observation -> action (`octax_gym.play.agents`), or None.
         players: each seat's player ("human", "agent", "scripted", "random"); default: a human
             in seat 0, the agent if there is one else "human" for one player; for two, seat 1
@@ -69,6 +84,7 @@ class Session:
 
     def __init__(self, game: Any, *, seed: int = 0, agent: Optional[Agent] = None,
                  players: Optional[list[str]] = None, recorder=None, **env_options):
+        seed = check_seed(seed)  # before anything is compiled
         self.spec = resolve_spec(game)
         self.two_player = is_two_player(self.spec)
         cls = MultiAgentVectorEnv if self.two_player else OctaxVectorEnv
@@ -171,14 +187,15 @@ class Session:
 
     @property
     def seed(self) -> int:
-        return self.seed0 + self.episode
+        return episode_seed(self.seed0, self.episode)
 
     def reset(self) -> dict:
-        """Ends the episode in play (the recorder keeps it if a human played it) and starts the next."""
+        """Ends the episode in play (the recorder keeps it if a human played it) and starts the
+        next; the episode count moves only once the env has reset."""
         self._finish(cut=True)
-        self.episode += 1
         options = None if self.obs is None else {"reset_mask": np.ones(1, np.bool_)}
-        self.obs, self.info = self.env.reset(seed=self.seed, options=options)
+        self.obs, self.info = self.env.reset(seed=episode_seed(self.seed0, self.episode + 1), options=options)
+        self.episode += 1
         self.done = False
         self.step_count = 0
         self.returns = np.zeros(self.seats, np.float64)
