@@ -24,6 +24,13 @@ from octax_core.tools.octo.tokens import Token, TokenStream, tokenize
 
 PROGRAM_START = 0x200
 MEMORY_SIZE = 0x10000
+# Macros and string modes expand by splicing tokens back into the stream, so a macro that calls
+# itself would expand forever, and N macros that each use the next twice expand to 2**N tokens.
+# Octo has no limit; these stop both with an error, in a few seconds at most. Real programs nest
+# a handful of levels and expand to tens of thousands of tokens (of the 116 Octo sources in
+# ../shared, wdl.8o expands the most: 37,111).
+MAX_EXPANSION_DEPTH = 256
+MAX_EXPANDED_TOKENS = 500_000
 
 RESERVED_WORDS = frozenset((
     ":=", "|=", "&=", "^=", "-=", "=-", "+=", ">>=", "<<=", "==", "!=", "<", ">", "<=", ">=",
@@ -132,6 +139,7 @@ class _Assembler:
         self.loops: list[_Flow] = []
         self.branches: list[_Flow] = []
         self.whiles: list[_Flow] = []
+        self.expanded = 0  # tokens spliced in by macros and string modes so far
 
     # ---- driver ---------------------------------------------------------------------------
 
@@ -443,6 +451,7 @@ class _Assembler:
 
     def expand_macro(self, name: str, call: Token) -> None:
         macro = self.macros[name]
+        depth = self.expansion_depth(f"macro '{name}'", call)
         bindings: dict[str, Token] = {"CALLS": Token(float(macro.calls), call.line, call.column)}
         macro.calls += 1
         for arg in macro.args:
@@ -450,10 +459,12 @@ class _Assembler:
                 raise self.stream.error(f"not enough arguments for macro '{name}': it takes "
                                         f"{len(macro.args)} ({' '.join(macro.args)})", call)
             bindings[arg] = self.stream.next()
-        self.stream.splice(self.instantiate(macro.body, bindings, f"macro '{name}' called at line {call.line}"))
+        where = call.expansion or f"macro '{name}' called at line {call.line}"  # the source's call
+        self.splice(self.instantiate(macro.body, bindings, where, depth), f"macro '{name}'", call)
 
     def expand_string_mode(self, name: str, call: Token) -> None:
         mode = self.string_modes[name]
+        depth = self.expansion_depth(f"string mode '{name}'", call)
         text = self.string(f"a string for the string mode '{name}'")
         expansion = []
         for index, char in enumerate(text.value):
@@ -466,16 +477,41 @@ class _Assembler:
             mode.calls += 1
             expansion += self.instantiate(
                 mode.bodies[char], {k: Token(v, call.line, call.column) for k, v in bindings.items()},
-                f"string mode '{name}' used at line {call.line}")
-        self.stream.splice(expansion)
+                call.expansion or f"string mode '{name}' used at line {call.line}", depth)
+            if self.expanded + len(expansion) > MAX_EXPANDED_TOKENS:
+                break  # `splice` reports it; a long string must not build a huge list first
+        self.splice(expansion, f"string mode '{name}'", call)
+
+    def expansion_depth(self, what: str, call: Token) -> int:
+        """The depth of the tokens `call` expands to; an error past MAX_EXPANSION_DEPTH."""
+        if call.depth >= MAX_EXPANSION_DEPTH:
+            raise self.stream.error(
+                f"{what} expands too deep: more than {MAX_EXPANSION_DEPTH} macro expansions nested "
+                "inside each other. A macro that calls itself (directly, through another macro, or "
+                "by rebuilding its own call from its arguments) never stops", call)
+        return call.depth + 1
+
+    def splice(self, tokens: list[Token], what: str, call: Token) -> None:
+        """Puts an expansion in front of the stream, within the MAX_EXPANDED_TOKENS budget."""
+        self.expanded += len(tokens)
+        if self.expanded > MAX_EXPANDED_TOKENS:
+            raise self.stream.error(
+                f"macro expansion produced more than {MAX_EXPANDED_TOKENS:,} tokens (here in "
+                f"{what}): macros that each use the next several times multiply, so this "
+                "program would never finish assembling", call)
+        self.stream.splice(tokens)
 
     @staticmethod
-    def instantiate(body: list[Token], bindings: dict[str, Token], where: str) -> list[Token]:
+    def instantiate(body: list[Token], bindings: dict[str, Token], where: str, depth: int) -> list[Token]:
+        """The body with its arguments bound. Every token, arguments included, is marked `depth`:
+        an argument passed on is expanded again, and `dup dup` with `:macro dup X { X X }` must
+        count as deeper each time it rebuilds itself."""
         out = []
         for token in body:
             bound = bindings.get(token.value) if not token.is_number else None
             chosen = bound or token
-            out.append(chosen if chosen.expansion else dataclasses.replace(chosen, expansion=where))
+            out.append(Token(chosen.value, chosen.line, chosen.column, chosen.quoted,
+                             chosen.expansion or where, depth))
         return out
 
     def block_body(self, what: str) -> list[Token]:

@@ -10,6 +10,7 @@ the stream, so the stream is a stack: the next token is the last element of a re
 from __future__ import annotations
 
 import dataclasses
+import math
 import re
 from typing import Optional, Union
 
@@ -27,7 +28,9 @@ class Token:
     """One token: `value` is a float for numbers, else the text; `line`/`column` are 1-based.
 
     `quoted` marks a string literal (Octo treats it as a name otherwise, so `"main"` is `main`).
-    `expansion` names the macro call a spliced token came from, for error messages.
+    `expansion` names the macro call a spliced token came from, for error messages; `depth` counts
+    the macro expansions that produced it (0 in the source), which is how the assembler stops a
+    macro that calls itself.
     """
 
     value: Union[float, str]
@@ -35,6 +38,7 @@ class Token:
     column: int
     quoted: bool = False
     expansion: Optional[str] = None
+    depth: int = 0
 
     @property
     def is_number(self) -> bool:
@@ -52,9 +56,16 @@ def _number_text(value: float) -> str:
 
 
 def parse_number(text: str) -> Optional[float]:
-    """The number a token spells, or None when it is a name (c-octo's rules)."""
+    """The number a token spells, or None when it is a name (c-octo's rules).
+
+    Raises:
+        OverflowError: the number is beyond a double's range (about 1.8e308).
+    """
     if _DECIMAL.fullmatch(text) or _HEX.fullmatch(text):
-        return float(int(text, 16)) if "x" in text.lower() else float(text)
+        value = float(int(text, 16)) if "x" in text.lower() else float(text)
+        if math.isinf(value):  # strtod gives inf for 1e400; float() of a long hex int raises
+            raise OverflowError(f"{text} is beyond a double's range")
+        return value
     for prefix, base in (("0b", 2), ("0x", 16), ("-0b", 2), ("-0x", 16)):
         if text.startswith(prefix):
             # strtol: the longest run of valid digits, 0 when there is none.
@@ -68,7 +79,8 @@ def tokenize(source: str) -> list[Token]:
     """Every token of `source`, in order.
 
     Raises:
-        AssemblyError: an unterminated string or an unknown escape (with its line and column).
+        AssemblyError: an unterminated string, an unknown escape or a number too large for a
+            double (with its line and column).
     """
     if source.startswith("\ufeff"):
         source = source[1:]
@@ -96,7 +108,11 @@ def tokenize(source: str) -> list[Token]:
         word = source[index:end]
         column += end - index
         index = end
-        number = parse_number(word)
+        try:
+            number = parse_number(word)
+        except OverflowError:
+            raise located(f"the number '{word}' is too large: numbers must lie within a double's "
+                          "range (about 1.8e308)", source, start_line, start_column) from None
         tokens.append(Token(word if number is None else number, start_line, start_column))
     return tokens
 
