@@ -30,7 +30,7 @@ import zipfile
 from pathlib import Path
 from typing import Iterable, Iterator, Optional, Protocol, Sequence, Union
 
-from octax_core.emulator.rom import Rom
+from octax_core.emulator.rom import Rom, read_rom_file
 
 PathLike = Union[str, os.PathLike]
 
@@ -140,6 +140,7 @@ def find_rom(spec: RomSpec, path: Optional[PathLike] = None) -> Path:
     Raises:
         RomNotFoundError: no such file; the message names the game, file, hash and the fix.
         RomHashError: the file found has another SHA-1.
+        RomTooLargeError: the file holds more than 65024 bytes (read no further than that).
     """
     return _locate_verified(spec, path)[0]
 
@@ -155,7 +156,7 @@ def rom_status(specs: Iterable[RomSpec]) -> list[RomStatus]:
     rows = []
     for spec in specs:
         found = _first_existing(spec.rom_file, search_dirs())
-        actual = sha1_hex(found.read_bytes()) if found else None
+        actual = _file_sha1(found) if found else None
         rows.append(RomStatus(spec.id, spec.rom_file, spec.rom_sha1.lower(), found,
                               actual == spec.rom_sha1.lower(), actual))
     return rows
@@ -244,13 +245,23 @@ def _locate_verified(spec: RomSpec, path: Optional[PathLike]) -> tuple[Path, byt
         found = _first_existing(spec.rom_file, dirs)
         if found is None:
             raise RomNotFoundError(_missing_message(spec, dirs))
-    data = found.read_bytes()
+    data = read_rom_file(found)  # RomTooLargeError after 65025 bytes, never the whole file
     actual = sha1_hex(data)
     if actual != spec.rom_sha1.lower():
         raise RomHashError(
             f"game {spec.id!r}: refusing ROM {str(found)!r}: SHA-1 is {actual}, expected {spec.rom_sha1}. "
             f"Remove or replace the file; to reinstall the right one, {FIX_HINT}")
     return found, data
+
+
+def _file_sha1(path: Path) -> str:
+    """A file's SHA-1, read in 1 MiB pieces: `rom_status` lists what is there, a 1 GiB file too,
+    without holding it in memory."""
+    digest = hashlib.sha1(usedforsecurity=False)
+    with open(path, "rb") as file:
+        for piece in iter(lambda: file.read(1 << 20), b""):
+            digest.update(piece)
+    return digest.hexdigest()
 
 
 def _first_existing(rom_file: str, dirs: Sequence[Path]) -> Optional[Path]:
