@@ -38,6 +38,9 @@ def add_commands(commands: argparse._SubParsersAction) -> None:
                       help="S in 0..4294967295; episode e is seeded (S + e) mod 2**32 (default 0)")
     play.add_argument("--agent", type=Path, metavar="PATH",
                       help="a trained agent: params.msgpack from the JAX examples, or a Stable-Baselines3 zip")
+    play.add_argument("--trust-agent", action="store_true",
+                      help="load an SB3 zip the player cannot rebuild as data with SB3's own loader, which runs "
+                           "code stored in the file: only for files you trust (docs/play.md)")
     play.add_argument("--players", metavar="P[,P]",
                       help="who plays each seat: human, agent, scripted (two-player games), random "
                            "(default: human, and for two players the agent, else the scripted player)")
@@ -84,7 +87,7 @@ def _cmd_play(args: argparse.Namespace) -> int:
     agent = None
     if args.agent is not None:
         from octax_gym.play.agents import load_agent
-        agent = load_agent(args.agent, num_actions)
+        agent = load_agent(args.agent, num_actions, trust=args.trust_agent)
     players = None if args.players is None else [p.strip() for p in args.players.split(",")]
     if players is not None and len(players) != (2 if two else 1):
         raise ValueError(f"--players takes {2 if two else 1} name(s) for {spec.id}, got {args.players!r}")

@@ -6,8 +6,11 @@ Two formats:
   `train_jax_pqn.py`, `train_jax_selfplay.py`: `flax.serialization.to_bytes` of
   `examples/jax_networks.py`'s `ActorCritic` or `QNetwork`), run by `octax_gym.jax_policy` in
   plain JAX, so the examples need not be importable; it plays greedily (the largest logit or Q-value). Needs flax (the `train` extra).
-* `*.zip`: a Stable-Baselines3 model (`model.save(...)`: PPO, A2C or DQN), played with
-  `model.predict(obs, deterministic=True)`. Needs the `sb3` extra.
+* `*.zip`: a Stable-Baselines3 model (`model.save(...)`: PPO, A2C or DQN over
+  `octax_gym.sb3.OctaxCNNExtractor`), played with `policy.predict(obs, deterministic=True)` as the
+  model's own `predict`. SB3's loader unpickles the zip, which runs any code stored in it, so the
+  policy is rebuilt from the zip's JSON and tensors alone (`octax_gym.play.sb3_zip`); other zips
+  are refused unless `trust=True` (`--trust-agent`) hands them to SB3's loader. Needs the `sb3` extra.
 
 An agent trained on one-player observations (F frames) and set in a two-player seat is given the
 F screens without the player plane; one trained with the plane (self-play) gets it.
@@ -28,18 +31,23 @@ from octax_gym import jax_policy
 Agent = Callable[[np.ndarray], int]
 
 
-def load_agent(path, num_actions: int) -> Agent:
+def load_agent(path, num_actions: int, *, trust: bool = False) -> Agent:
     """The agent saved at `path` (.msgpack or .zip) for a game of `num_actions` actions.
 
+    Args:
+        trust: load an SB3 zip with SB3's own loader, which unpickles it (runs code stored in the
+            file): only for files the user vouches for. Without it nothing in the file runs.
+
     Raises:
-        FileNotFoundError: no such file. ValueError: an unknown format, or params that do not
-        fit the game. ImportError: flax or stable-baselines3 missing.
+        FileNotFoundError: no such file. ValueError: an unknown format, params that do not fit the
+        game, or (`sb3_zip.AgentFileError`) a zip that cannot be read without running code from
+        it. ImportError: flax or stable-baselines3 missing.
     """
     path = Path(path).expanduser()
     if not path.is_file():
         raise FileNotFoundError(f"no agent file {path}")
     if zipfile.is_zipfile(path):
-        return _sb3_agent(path, num_actions)
+        return _sb3_agent(path, num_actions, trust)
     return _jax_agent(path, num_actions)
 
 
@@ -55,12 +63,27 @@ def _jax_agent(path: Path, num_actions: int) -> Agent:
     return _fit_channels(lambda obs: int(greedy(jnp.asarray(obs))), network.channels)
 
 
-def _sb3_agent(path: Path, num_actions: int) -> Agent:
+def _sb3_agent(path: Path, num_actions: int, trust: bool) -> Agent:
     try:
-        from stable_baselines3 import A2C, DQN, PPO
+        import stable_baselines3  # noqa: F401
     except ImportError as exc:
         raise ImportError(f"--agent {path.name} (an SB3 zip) needs stable-baselines3: "
                           f"pip install 'octax-gym[sb3]' ({exc})") from exc
+    if trust:
+        model, channels, actions = _trusted_sb3_model(path)
+    else:
+        from octax_gym.play.sb3_zip import load_policy
+        model, channels, actions = load_policy(path)
+    if actions != num_actions:
+        raise ValueError(f"{path} plays {actions} actions; this game has {num_actions}")
+    return _fit_channels(lambda obs: int(np.asarray(model.predict(obs, deterministic=True)[0]).reshape(-1)[0]),
+                         channels)
+
+
+def _trusted_sb3_model(path: Path):
+    """SB3's own loader (it unpickles the file): the model, its input planes and its actions."""
+    from stable_baselines3 import A2C, DQN, PPO
+
     errors = []
     for algorithm in (PPO, A2C, DQN):
         try:
@@ -70,11 +93,7 @@ def _sb3_agent(path: Path, num_actions: int) -> Agent:
             errors.append(f"{algorithm.__name__}: {exc!r}"[:200])
     else:
         raise ValueError(f"{path} is not a Stable-Baselines3 PPO, A2C or DQN model ({'; '.join(errors)})")
-    if getattr(model.action_space, "n", None) != num_actions:
-        raise ValueError(f"{path} plays {getattr(model.action_space, 'n', '?')} actions; this game has {num_actions}")
-    channels = int(model.observation_space.shape[0])
-    return _fit_channels(lambda obs: int(np.asarray(model.predict(obs, deterministic=True)[0]).reshape(-1)[0]),
-                         channels)
+    return model, int(model.observation_space.shape[0]), getattr(model.action_space, "n", "?")
 
 
 def _fit_channels(act: Callable[[np.ndarray], int], channels: int) -> Agent:

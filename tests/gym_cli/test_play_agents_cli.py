@@ -74,9 +74,10 @@ def test_sb3_zip_plays(tmp_path):
     venv = make_sb3_vec_env(GAME, 2)
     model = PPO("CnnPolicy", venv, **{**ppo_kwargs(2, 1), "n_steps": 8, "batch_size": 16}, seed=0)
     model.save(tmp_path / "agent.zip")
-    agent = load_agent(tmp_path / "agent.zip", venv.action_space.n)
+    agent = load_agent(tmp_path / "agent.zip", venv.action_space.n)  # rebuilt from data, not unpickled
     obs = venv.reset()
     assert agent(obs[0]) == int(model.predict(obs[:1], deterministic=True)[0][0])
+    # More cases, and zips that run code when SB3 loads them: test_agent_files_safety.py
     session = Session(GAME, agent=agent)
     assert session.players == ["agent"]
     actions = {session.step()["actions"][0] for _ in range(10)}
@@ -135,7 +136,7 @@ def test_cli_parser_and_errors(capsys):
     with pytest.raises(SystemExit):
         main(["play", "--help"])
     out = capsys.readouterr().out
-    assert "--agent" in out and "--record" in out and "--host" in out
+    assert "--agent" in out and "--record" in out and "--host" in out and "--trust-agent" in out
     assert main(["play", "NoSuchGame"]) == 1
     assert main(["play", "Duel", "--record", "x/Duel-v0"]) == 1
     assert "two-player" in capsys.readouterr().err
