@@ -9,21 +9,30 @@
 the arguments given; else the torchrun-style variables MASTER_ADDR, MASTER_PORT, WORLD_SIZE and
 RANK; else nothing, which lets JAX detect SLURM (and other clusters) itself. On CPU it selects
 Gloo for the collectives, so CPU-only processes (this machine, CI) can run a sharded batch too.
-A coordinator that cannot be reached within `timeout_s` is a `DistributedInitError` naming it,
-never a hang: the other processes wait for process 0's port to open before they join (JAX itself
-aborts the whole process, with no Python exception, when registering with a coordinator times
-out). Process 0 waits `timeout_s` for the others to join, then JAX ends it with its
-DEADLINE_EXCEEDED error. See docs/scale.md.
+
+JAX checks little itself and answers most start-up mistakes by aborting the process (SIGABRT, no
+Python exception, after its timeout), or not at all (ranks that disagree on the process count
+joined as the smaller run). So when the coordinator's address is known, the processes first meet
+on its port through a handshake of our own: process 0 holds the port, every other process sends
+its (num_processes, process_id), and process 0 answers every one once all have come, then frees
+the port for JAX's coordinator. A count that differs from process 0's, an id given twice, a port
+held by a program that does not speak the handshake, a coordinator that cannot be reached or
+processes that do not come within `timeout_s` are each a `DistributedInitError` naming the
+mismatch, on every process that took part. What is left to JAX (a process that stops between the
+handshake and JAX's own registration, runs started from SLURM's variables, which skip the
+handshake) still aborts; the line printed before calling JAX names the likely causes. See
+docs/scale.md, "Start-up failures".
 """
 
 from __future__ import annotations
 
 import os
-import socket
-import time
+import sys
 from typing import Optional
 
 import jax
+
+from octax_gym import handshake
 
 TORCHRUN_VARIABLES = ("MASTER_ADDR", "MASTER_PORT", "WORLD_SIZE", "RANK")
 
@@ -39,53 +48,75 @@ def initialize(coordinator_address: Optional[str] = None, num_processes: Optiona
     Args:
         coordinator_address: "host:port" of process 0's coordinator service.
         num_processes, process_id: the run's size and this process's rank.
-        timeout_s: how long to wait for every process to join.
+        timeout_s: how long to wait for every process to join (the handshake, then JAX, each this long).
         cpu_collectives: the CPU collectives implementation ("gloo"; "mpi" where JAX has it).
 
     Raises:
-        DistributedInitError: the coordinator was not reached, or not every process joined, in time.
-        ValueError: a partial set of torchrun-style variables, or a bad rank or size.
+        DistributedInitError: the coordinator was not reached, its port answered something else, the
+            processes disagree on the process count or give an id twice, or not every process came in time.
+        ValueError: a partial set of torchrun-style variables, or a bad address, rank or size.
     """
     if coordinator_address is None and num_processes is None and process_id is None:
-        present = [name for name in TORCHRUN_VARIABLES if name in os.environ]
-        if present and len(present) != len(TORCHRUN_VARIABLES):
-            missing = sorted(set(TORCHRUN_VARIABLES) - set(present))
-            raise ValueError(f"torchrun-style launch variables set in part: {', '.join(present)} without "
-                             f"{', '.join(missing)}")
-        if present:
-            coordinator_address = f"{os.environ['MASTER_ADDR']}:{os.environ['MASTER_PORT']}"
-            num_processes, process_id = int(os.environ["WORLD_SIZE"]), int(os.environ["RANK"])
-    if num_processes is not None and (num_processes < 1 or process_id is None
-                                      or not 0 <= process_id < num_processes):
-        raise ValueError(f"process_id must be in 0..num_processes - 1, got process_id={process_id}, "
-                         f"num_processes={num_processes}")
-    if coordinator_address is not None and process_id not in (None, 0):
-        _wait_for_coordinator(coordinator_address, timeout_s, process_id, num_processes)
+        coordinator_address, num_processes, process_id = _from_torchrun_variables()
+    _check_arguments(coordinator_address, num_processes, process_id)
+    met = coordinator_address is not None and num_processes > 1
+    if met:
+        try:
+            handshake.meet(coordinator_address, num_processes, process_id, timeout_s)
+        except handshake.HandshakeError as exc:
+            raise DistributedInitError(str(exc)) from None
     jax.config.update("jax_cpu_collectives_implementation", cpu_collectives)
+    where = coordinator_address or "the address JAX detected from the cluster's variables"
+    if num_processes != 1:  # JAX ends the process without a Python exception when registering fails: say why first
+        print(_abort_warning(process_id, num_processes, where, met), file=sys.stderr, flush=True)
     try:
         jax.distributed.initialize(coordinator_address, num_processes, process_id,
                                    initialization_timeout=timeout_s)
     except Exception as exc:  # XLA's DEADLINE_EXCEEDED and connection errors, as JaxRuntimeError/RuntimeError
-        where = coordinator_address or "the address JAX detected from the cluster's variables"
         raise DistributedInitError(
             f"process {process_id} of {num_processes} could not join the run coordinated at {where} within "
             f"{timeout_s} s: is process 0 running, reachable there, and are all {num_processes} processes "
             f"started? ({type(exc).__name__}: {str(exc).splitlines()[0] if str(exc) else ''})") from exc
 
 
-def _wait_for_coordinator(address: str, timeout_s: float, process_id, num_processes) -> None:
-    """Returns once a TCP connection to `address` opens; raises DistributedInitError after `timeout_s`."""
-    host, _, port = address.rpartition(":")
-    if not host or not port.isdigit():
-        raise ValueError(f"coordinator_address must be 'host:port', got {address!r}")
-    deadline = time.monotonic() + timeout_s
-    while True:
+def _abort_warning(process_id, num_processes, where: str, met: bool) -> str:
+    """The line printed before JAX's registration: the causes left when this process ends without a traceback."""
+    causes = ("another process stopped between the start-up handshake and JAX's registration" if met else
+              "with no start-up handshake (the cluster gave the address), a process that never started, processes "
+              "that disagree on the process count, an id given twice, or a coordinator port held by another program")
+    return (f"octax-gym: process {process_id} of {num_processes} is joining JAX's runtime at {where}; if JAX now "
+            f"ends it (SIGABRT, no Python exception), the likely cause is {causes} (docs/scale.md, 'Start-up "
+            f"failures')")
+
+
+def _from_torchrun_variables() -> tuple:
+    """The address, size and rank the torchrun-style variables give, or three Nones when none is set."""
+    present = [name for name in TORCHRUN_VARIABLES if name in os.environ]
+    if not present:
+        return None, None, None
+    if len(present) != len(TORCHRUN_VARIABLES):
+        missing = sorted(set(TORCHRUN_VARIABLES) - set(present))
+        raise ValueError(f"torchrun-style launch variables set in part: {', '.join(present)} without "
+                         f"{', '.join(missing)}")
+    sizes = []
+    for name in ("WORLD_SIZE", "RANK"):
         try:
-            with socket.create_connection((host.strip("[]"), int(port)), timeout=1.0):
-                return
-        except OSError as exc:
-            if time.monotonic() >= deadline:
-                raise DistributedInitError(
-                    f"process {process_id} of {num_processes} could not reach the coordinator at {address} "
-                    f"within {timeout_s} s ({exc}): is process 0 running and reachable there?") from None
-            time.sleep(0.2)
+            sizes.append(int(os.environ[name]))
+        except ValueError:
+            raise ValueError(f"{name} must be an integer, got {os.environ[name]!r}") from None
+    return f"{os.environ['MASTER_ADDR']}:{os.environ['MASTER_PORT']}", *sizes
+
+
+def _check_arguments(coordinator_address, num_processes, process_id) -> None:
+    """Refuses what JAX would abort on, or take silently, before anything starts."""
+    if (num_processes is None) != (process_id is None):
+        raise ValueError(f"num_processes and process_id go together: got num_processes={num_processes}, "
+                         f"process_id={process_id}")
+    if num_processes is not None:
+        if not handshake.is_int(num_processes) or num_processes < 1:
+            raise ValueError(f"num_processes must be an integer >= 1, got {num_processes!r}")
+        if not handshake.is_int(process_id) or not 0 <= process_id < num_processes:
+            raise ValueError(f"process_id must be in 0..num_processes - 1, got process_id={process_id!r}, "
+                             f"num_processes={num_processes}")
+    if coordinator_address is not None:
+        handshake.split_address(coordinator_address)
