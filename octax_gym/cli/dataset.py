@@ -139,14 +139,13 @@ def _cmd_combine(args: argparse.Namespace) -> int:
 
 def _cmd_finish(args: argparse.Namespace) -> int:
     from octax_gym.datasets import finish_dataset
-    from octax_gym.datasets.storage import import_minari
+    from octax_gym.datasets.damage import load_checked
+    from octax_gym.datasets.storage import dataset_folder, import_minari
 
-    minari = import_minari()
+    import_minari()
     with _datasets_path(args.data_path):
-        changed = finish_dataset(args.dataset)
-        folder = Path(args.dataset)
-        dataset = minari.MinariDataset(folder / "data") if (folder / "data").is_dir() else \
-            minari.load_dataset(args.dataset)
+        changed = finish_dataset(args.dataset)  # a damaged folder: a DamagedDatasetError naming the file
+        dataset = load_checked(dataset_folder(args.dataset) / "data")
     state = "made one file" if changed else "already one file"
     print(f"{args.dataset}: {state}; {dataset.total_episodes} episodes, {dataset.total_steps} steps")
     return 0

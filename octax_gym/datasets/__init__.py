@@ -11,6 +11,8 @@ transitions, and build the dataset suite.
   CHIP-8 step instead of ~9,400), read back bit for bit by `minari.load_dataset`.
 - `transitions`: the loader and minibatch sampler (numpy, or JAX inside jit).
 - `suite`: the dataset suite (octax/<Game>/random|medium|expert-v0) from trained PPO policies.
+- `diskwrite`: HDF5 written so that a full disk is a `DatasetWriteError` (an OSError), not a crash.
+- `damage`: a damaged dataset folder as a `DamagedDatasetError` (a ValueError) naming the file.
 
 Minari is the optional `datasets` extra, imported inside the functions: `import octax_gym.datasets`
 works without it. See docs/datasets.md.
@@ -26,6 +28,7 @@ _EXPORTS = {
     "Batch": "transitions", "Transitions": "transitions", "load_transitions": "transitions",
     "build_suite": "suite", "pick_policies": "suite",
     "combine_datasets": "combine", "shard_plan": "combine",
+    "DatasetWriteError": "diskwrite", "DamagedDatasetError": "damage",
 }
 __all__ = sorted(_EXPORTS)
 

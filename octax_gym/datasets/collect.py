@@ -39,7 +39,9 @@ from octax_gym import action_check, compiled_step
 from octax_gym.choices import check_names
 from octax_gym.compiled_step import GYM_ENV_OPTIONS, MAX_SEED
 from octax_gym.game_names import resolve_env_id
-from octax_gym.datasets.storage import DatasetWriter, EpisodeRecord, check_dataset_id, import_minari
+from octax_gym.datasets.diskwrite import DatasetWriteError
+from octax_gym.datasets.storage import (DatasetWriter, EpisodeRecord, check_dataset_id, import_minari,
+                                        kept_episodes)
 from octax_gym.policies import Act, Policy, check_policy, make_policy, policy_name
 
 # Finished episodes are written once they hold this many steps: ~160 MB of 32 x 64 frames (CHIP-8),
@@ -117,6 +119,10 @@ def collect_dataset(env_id: str, dataset_id: str, num_steps: int, *, num_envs: i
             one out of range).
         TypeError: a policy returning actions that are not integers.
         ImportError: Minari (the `datasets` extra) is not installed.
+        DatasetWriteError: an OSError: a write failed (a full disk, a file-size limit). The
+            episodes of the groups written before stay, a dataset as a kill leaves it; the
+            message says how many and how to make them one file. Any other error removes the
+            dataset's folder.
     """
     minari = import_minari()
     gym_id = resolve_env_id(env_id)
@@ -149,6 +155,11 @@ def collect_dataset(env_id: str, dataset_id: str, num_steps: int, *, num_envs: i
             _collect(lanes, act, num_steps, seed, writer, bar)
         dataset = writer.close()
         seconds = time.perf_counter() - start
+    except DatasetWriteError as exc:  # a full disk: the episodes written are kept, as a kill keeps them
+        if kept_episodes(path)[0] == 0:
+            shutil.rmtree(path, ignore_errors=True)
+            raise exc.with_outcome("no episode had been written; nothing is kept") from exc
+        raise
     except BaseException:
         shutil.rmtree(path, ignore_errors=True)  # no half-written dataset left behind
         raise

@@ -53,7 +53,10 @@ def combine_datasets(shard_ids: Sequence[str], dataset_id: str, *, overwrite: bo
     Raises:
         ValueError: fewer than one shard, shards of different envs or spaces, a seed in two
             shards, or an existing `dataset_id` without `overwrite`.
+        DatasetWriteError: an OSError: a write failed (a full disk); the combined dataset is
+            removed, the shards are unchanged.
     """
+    from octax_gym.datasets.diskwrite import DatasetWriteError
     from octax_gym.datasets.storage import DatasetWriter, EpisodeRecord, check_dataset_id, import_minari
 
     minari = import_minari()
@@ -91,6 +94,9 @@ def combine_datasets(shard_ids: Sequence[str], dataset_id: str, *, overwrite: bo
             for meta, episode in zip(metas, shard.storage.get_episodes(shard.episode_indices)):
                 writer.add(EpisodeRecord.from_stored(int(meta["seed"]), episode), cut=False)
         return writer.close()
+    except DatasetWriteError as exc:
+        shutil.rmtree(path, ignore_errors=True)
+        raise exc.with_outcome(f"{dataset_id!r} is removed; the shards are unchanged") from exc
     except BaseException:
         shutil.rmtree(path, ignore_errors=True)
         raise

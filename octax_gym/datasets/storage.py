@@ -30,10 +30,16 @@ place:
   compressed chunks as they are), renames it into place and deletes the parts.
 A collection killed part way is a dataset of links into its parts, readable as it is;
 `finish_dataset` turns it into the one-file form `close()` leaves.
+
+A full disk ends the writer as a kill would, with an error instead: every HDF5 file is written
+through `diskwrite.HDF5Writing` (libhdf5's own driver crashed the process on a failed write), the
+temporary file is removed, and `DatasetWriteError` (an OSError) names the file and says what is
+kept. `finish_dataset` checks a folder before it changes anything (`damage.check_dataset_files`).
 """
 
 from __future__ import annotations
 
+import contextlib
 import json
 import os
 import secrets
@@ -43,6 +49,9 @@ from pathlib import Path
 from typing import Any, Optional
 
 import numpy as np
+
+from octax_gym.datasets.damage import DamagedDatasetError, check_dataset_files, reading_hdf5
+from octax_gym.datasets.diskwrite import DatasetWriteError, HDF5Writing, is_out_of_space
 
 INSTALL_HINT = 'pip install "octax-gym[datasets]"'
 
@@ -152,9 +161,16 @@ class DatasetWriter:
 
     def close(self):
         """Writes what is left, makes `main_data.hdf5` one self-contained file; returns the
-        `minari.MinariDataset`."""
+        `minari.MinariDataset`.
+
+        Raises:
+            DatasetWriteError: a write failed (a full disk); the message says what is kept.
+        """
         self.flush()
-        finish_dataset(self.path.parent)
+        try:
+            finish_dataset(self.path.parent)
+        except DatasetWriteError as exc:
+            raise exc.with_outcome(_kept_outcome(self.path.parent)) from exc
         import minari
 
         return minari.MinariDataset(self.path)
@@ -162,23 +178,39 @@ class DatasetWriter:
     def flush(self) -> None:
         """Writes the pending episodes to a new part, links them from `main_data.hdf5`, then writes
         the metadata's totals; each file is renamed into place whole, so the dataset on disk is
-        whole at every instant."""
+        whole at every instant.
+
+        Raises:
+            DatasetWriteError: a write failed (a full disk): the dataset is as the last flush left
+                it, and the message says so.
+        """
+        try:
+            self._flush()
+        except DatasetWriteError as exc:
+            raise exc.with_outcome(_kept_outcome(self.path.parent)) from exc
+
+    def _flush(self) -> None:
         if not self._pending:
             return
         import h5py
 
         part = Path(PARTS) / f"part-{self._parts:05d}.hdf5"
-        (self.path / PARTS).mkdir(exist_ok=True)
+        try:
+            (self.path / PARTS).mkdir(exist_ok=True)
+        except OSError as exc:
+            if is_out_of_space(exc):
+                raise DatasetWriteError(exc.errno, self.path / PARTS) from exc
+            raise
         first = self.episodes
-        with _replacing(self.path / part) as tmp:
-            with h5py.File(tmp, "w", libver=LIBVER, track_order=True) as file:
-                for i, (seed, arrays) in enumerate(self._pending):
-                    self._write_episode(file, first + i, seed, arrays)
+        with _replacing(self.path / part) as tmp, HDF5Writing(tmp, "w") as out:
+            for i, (seed, arrays) in enumerate(self._pending):
+                self._write_episode(out.file, first + i, seed, arrays)
+                out.check()  # a full disk stops the part here
         with _replacing(self.path / MAIN_DATA) as tmp:
             shutil.copyfile(self.path / MAIN_DATA, tmp)
-            with h5py.File(tmp, "a", libver=LIBVER, track_order=True) as file:
+            with HDF5Writing(tmp, "r+") as out:
                 for i in range(first, first + len(self._pending)):
-                    file[f"episode_{i}"] = h5py.ExternalLink(part.as_posix(), f"/episode_{i}")
+                    out.file[f"episode_{i}"] = h5py.ExternalLink(part.as_posix(), f"/episode_{i}")
         self._parts += 1
         self.episodes += len(self._pending)
         self.steps += sum(len(arrays["actions"]) for _, arrays in self._pending)
@@ -213,9 +245,76 @@ def finish_dataset(dataset) -> bool:
 
     Raises:
         FileNotFoundError: no such dataset.
+        DamagedDatasetError: a file of the dataset is missing or unreadable (the message names
+            it); nothing is changed.
+        DatasetWriteError: a write failed (a full disk); the dataset is as it was.
     """
     import h5py
 
+    data = dataset_folder(dataset) / "data"
+    check_dataset_files(data)
+    parts = data / PARTS
+    if not parts.exists():
+        return False
+    with reading_hdf5(data / MAIN_DATA) as linked:
+        names = list(linked.keys())
+        links = {name: linked.get(name, getlink=True) for name in names}
+    if any(isinstance(link, h5py.ExternalLink) for link in links.values()):
+        try:
+            _copy_into_one_file(data, names, links)
+        except DatasetWriteError as exc:
+            raise exc.with_outcome(f"the dataset at {data.parent} is unchanged and loads as it is, its episodes "
+                                   f"read through {PARTS}/; free space and run `octax-gym dataset finish "
+                                   f"{data.parent}` again (it needs room for a copy of the episodes)") from exc
+    shutil.rmtree(parts)
+    update_metadata(data, {"dataset_size": data_size(data)})
+    return True
+
+
+def _copy_into_one_file(data: Path, names: list[str], links: dict[str, Any]) -> None:
+    """Every linked episode copied into a new main_data.hdf5, renamed into place."""
+    import h5py
+
+    with _replacing(data / MAIN_DATA) as tmp, HDF5Writing(tmp, "w") as out, contextlib.ExitStack() as stack:
+        sources: dict[str, Any] = {}
+        for name in names:
+            link = links[name]
+            if not isinstance(link, h5py.ExternalLink):
+                raise DamagedDatasetError(data / MAIN_DATA, f"holds {name} as well as links into {PARTS}/ (a "
+                                                            "dataset writes one or the other)")
+            if link.filename not in sources:
+                sources[link.filename] = stack.enter_context(reading_hdf5(data / link.filename))
+            try:
+                sources[link.filename].copy(link.path, out.file, name=name)
+            except (OSError, KeyError, RuntimeError) as exc:
+                out.check()  # a full disk, not the part, when the write failed
+                raise DamagedDatasetError(data / link.filename, f"cannot give {link.path} ({exc})") from exc
+            out.check()
+
+
+def kept_episodes(folder) -> tuple[int, int]:
+    """(episodes, steps) that the dataset at `folder` holds by its metadata.json; (0, 0) where
+    there is none or it cannot be read."""
+    try:
+        metadata = json.loads((Path(folder) / "data" / METADATA).read_text())
+        return int(metadata["total_episodes"]), int(metadata["total_steps"])
+    except (OSError, ValueError, KeyError, TypeError):
+        return 0, 0
+
+
+def _kept_outcome(folder: Path) -> str:
+    """What a writer stopped by a failed write leaves, said for its error."""
+    episodes, steps = kept_episodes(folder)
+    return (f"the {episodes} episodes ({steps} steps) written before are kept at {folder} and load as they are; "
+            f"free space, then run `octax-gym dataset finish {folder}` to make them one file (or delete the folder)")
+
+
+def dataset_folder(dataset) -> Path:
+    """The folder (holding data/) of a dataset id under Minari's datasets root, or of a folder.
+
+    Raises:
+        FileNotFoundError: neither names a dataset.
+    """
     folder = Path(dataset)
     if not (folder / "data").is_dir():
         from minari.storage import get_dataset_path
@@ -224,31 +323,7 @@ def finish_dataset(dataset) -> bool:
         if not (folder / "data").is_dir():
             raise FileNotFoundError(f"no dataset {str(dataset)!r}: neither a dataset folder (with data/) nor a "
                                     f"dataset id under {get_dataset_path()}")
-    data = folder / "data"
-    parts = data / PARTS
-    if not parts.exists():
-        return False
-    with h5py.File(data / MAIN_DATA, "r") as linked:
-        names = list(linked.keys())
-        links = {name: linked.get(name, getlink=True) for name in names}
-    if any(isinstance(link, h5py.ExternalLink) for link in links.values()):
-        with _replacing(data / MAIN_DATA) as tmp:
-            with h5py.File(tmp, "w", libver=LIBVER, track_order=True) as out:
-                sources: dict[str, Any] = {}
-                try:
-                    for name in names:
-                        link = links[name]
-                        if not isinstance(link, h5py.ExternalLink):
-                            raise ValueError(f"{data / MAIN_DATA}: {name} is not a link into {PARTS}/")
-                        if link.filename not in sources:
-                            sources[link.filename] = h5py.File(data / link.filename, "r")
-                        sources[link.filename].copy(link.path, out, name=name)
-                finally:
-                    for source in sources.values():
-                        source.close()
-    shutil.rmtree(parts)
-    update_metadata(data, {"dataset_size": data_size(data)})
-    return True
+    return folder
 
 
 def update_metadata(data_path: Path, changes: dict[str, Any]) -> None:
@@ -276,7 +351,8 @@ def data_size(data_path: Path) -> float:
 class _replacing:
     """`with _replacing(path) as tmp:` write `tmp`; on success it is synced and renamed to `path`
     (and the folder synced), on an exception removed. A kill at any point leaves `path` as it was
-    or as the whole new file."""
+    or as the whole new file. A full disk while writing or syncing `tmp` raises
+    `DatasetWriteError` naming `path`, `tmp` removed."""
 
     def __init__(self, path: Path):
         self.path = Path(path)
@@ -286,13 +362,23 @@ class _replacing:
         return self.tmp
 
     def __exit__(self, kind, value, traceback):
-        if kind is not None:
-            self.tmp.unlink(missing_ok=True)
+        if kind is None:
+            try:
+                with open(self.tmp, "rb") as f:
+                    os.fsync(f.fileno())  # where a filesystem reports a full disk late (NFS), it is here
+                os.replace(self.tmp, self.path)
+            except OSError as exc:
+                self.tmp.unlink(missing_ok=True)
+                if is_out_of_space(exc):
+                    raise DatasetWriteError(exc.errno, self.path) from exc
+                raise
+            _sync_dir(self.path.parent)
             return False
-        with open(self.tmp, "rb") as f:
-            os.fsync(f.fileno())
-        os.replace(self.tmp, self.path)
-        _sync_dir(self.path.parent)
+        self.tmp.unlink(missing_ok=True)
+        if is_out_of_space(value) and not isinstance(value, DatasetWriteError):
+            raise DatasetWriteError(value.errno, self.path) from value
+        if isinstance(value, DatasetWriteError) and value.filename == str(self.tmp):
+            raise DatasetWriteError(value.errno, self.path) from value  # the file's own name, not the temporary one
         return False
 
 
@@ -336,10 +422,8 @@ def _create(dataset_id: str, final: Path, arguments: dict[str, Any], extra: dict
     try:
         update_metadata(built, extra)
         if not (built / MAIN_DATA).exists():  # Minari writes no file for an empty buffer list
-            import h5py
-
-            with _replacing(built / MAIN_DATA) as tmp:
-                h5py.File(tmp, "w", libver=LIBVER, track_order=True).close()
+            with _replacing(built / MAIN_DATA) as tmp, HDF5Writing(tmp, "w"):
+                pass
         namespace = parse_dataset_id(dataset_id)[0]
         if namespace and namespace not in list_local_namespaces():
             try:
