@@ -20,6 +20,7 @@ Many games in one batch: `gym.make_vec("octax/Mix-v0", num_envs=N, games=[...])`
 `octax_core.make_mix`). See docs/mix.md.
 """
 
+from octax_core import __version__  # the installed distribution's, read in one place
 from octax_gym.action_check import IllegalMoveError, InvalidActionError
 from octax_gym.choices import UnknownOptionError
 from octax_gym.env import OctaxEnv
@@ -50,4 +51,4 @@ def __getattr__(name: str):
 
 __all__ = ["ENV_IDS", "IllegalMoveError", "MIX_ENV_ID", "InvalidActionError", "MultiAgentVectorEnv", "NAMESPACE", "OctaxEnv",
            "OctaxVectorEnv", "OpponentRequiredError", "PALETTES", "TWO_PLAYER_ENV_IDS", "UnknownOptionError", "env_id",
-           "make_multi_vec", "register_all", "register_game", "register_mix", "register_two_player", *_LAZY]
+           "__version__", "make_multi_vec", "register_all", "register_game", "register_mix", "register_two_player", *_LAZY]

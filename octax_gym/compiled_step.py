@@ -150,7 +150,11 @@ class CompiledStep:
 
     @staticmethod
     def _with_masks(info: dict) -> dict:
-        """Gymnasium's vector-info convention: each key `k` comes with a bool mask `_k`."""
+        """Gymnasium's vector-info convention: each key `k` comes with a bool mask `_k`. An
+        `action_mask` (a seat's against an opponent, a mix's) leaves as int8, the dtype
+        Gymnasium's `Discrete.sample(mask=...)` takes, as PettingZoo's masks are."""
+        if "action_mask" in info:
+            info = {**info, "action_mask": info["action_mask"].astype(jnp.int8)}
         return {**info, **{f"_{name}": jnp.ones(value.shape[:1], jnp.bool_) for name, value in info.items()}}
 
 

@@ -4,14 +4,16 @@ A game has a registry id ("Pong", "BlackRainbow" for an archive game) and a Gymn
 ("octax/Pong-v0"). Every place that takes a game by name (the envs, `video.record`,
 `collect_dataset`, the `octax-gym` commands) resolves it here, so each accepts the same
 spellings: either id, exactly or in any case. An unknown name raises one error,
-`UnknownOptionError` (a ValueError and a KeyError), naming the close matches and every id.
+`UnknownOptionError` (a ValueError and a KeyError), naming the close matches and every id. The
+close matches are the core's (`octax_core.env.games.close_names`, behind `octax_core.make`'s
+`UnknownGameError` too), so both layers suggest the same games.
 """
 
 from __future__ import annotations
 
 from typing import Union
 
-from octax_core.env.games import GameSpec, get_spec, list_games
+from octax_core.env.games import GameSpec, close_names, get_spec, list_games
 from octax_gym.choices import UnknownOptionError
 
 NAMESPACE = "octax"
@@ -44,7 +46,8 @@ def resolve_spec(game: Union[str, GameSpec], players: int = 1) -> GameSpec:
     if found is None:
         games = list_games(players=players)
         also = f"or their Gymnasium ids ({env_id(games[0])}, ...)" if games else ""
-        raise UnknownOptionError("game" if players == 1 else "two-player game", game, games, also, near=names)
+        raise UnknownOptionError("game" if players == 1 else "two-player game", game, games, also,
+                                 near=close_names(game, names))
     return get_spec(found)
 
 

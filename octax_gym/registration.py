@@ -8,6 +8,16 @@ import). Each id has an `entry_point` (`gymnasium.make` -> `OctaxEnv`) and a `ve
 The two-player games (`list_games(players=2)`) are registered too, the same way: with
 `opponent=` an id is one seat against a fixed opponent (`octax_gym.opponent`); a game that is
 not a one-player env (`GameSpec.solo` False) raises `OpponentRequiredError` without it.
+
+Each game's spec carries its episode bound, `max_episode_steps` (the game's own, 4,500 steps for
+most), so `env.spec.max_episode_steps` says where episodes are cut, as Gymnasium users read it.
+Its kwargs hold the env's keyword of that name as None, which says "the game's own, unless told",
+and makes each of Gymnasium's makers count the steps once: `make_vec` builds `OctaxVectorEnv`,
+which counts them inside the jitted step (its `max_episode_steps=` keyword, when given, replaces
+the None); `make` wraps the single env in Gymnasium's `TimeLimit` (the spec's number, or the one
+given to `make`), and the env, seeing the None, lifts its own bound (`OctaxEnv.spec`), so that
+`make(id, max_episode_steps=M)` cuts episodes at M, more steps than the game's default included.
+The mix's spec has no bound: each game of a mix keeps its own.
 """
 
 from __future__ import annotations
@@ -45,7 +55,7 @@ def register_mix() -> str:
         entry_point="octax_gym.env:OctaxEnv",
         vector_entry_point="octax_gym.vector:OctaxVectorEnv",
         kwargs={"game": "octax16"},
-        max_episode_steps=None,
+        max_episode_steps=None,  # no one number: each game of a mix keeps its own bound
         disable_env_checker=False,
     )
     return MIX_ENV_ID
@@ -57,10 +67,8 @@ def _register(game: str) -> str:
         id=gym_id,
         entry_point="octax_gym.env:OctaxEnv",
         vector_entry_point="octax_gym.vector:OctaxVectorEnv",
-        kwargs={"game": game},
-        # Truncation is the env's own (`max_episode_steps=` keyword, the game's default
-        # otherwise), counted inside the jitted step, so no TimeLimit wrapper is added.
-        max_episode_steps=None,
+        kwargs={"game": game, "max_episode_steps": None},  # see the module docstring
+        max_episode_steps=get_spec(game).max_episode_steps,
         disable_env_checker=False,
     )
     return gym_id
@@ -88,8 +96,8 @@ def register_game(spec: GameSpec, rom: Optional[Union[str, os.PathLike]] = None)
         id=gym_id,
         entry_point="octax_gym.env:OctaxEnv",
         vector_entry_point="octax_gym.vector:OctaxVectorEnv",
-        kwargs={"game": spec, "rom": None if rom is None else str(rom)},
-        max_episode_steps=None,
+        kwargs={"game": spec, "rom": None if rom is None else str(rom), "max_episode_steps": None},
+        max_episode_steps=spec.max_episode_steps,
         disable_env_checker=False,
     )
     return gym_id

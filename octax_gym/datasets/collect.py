@@ -171,11 +171,14 @@ def recovery_spec(gym_id: str, env_options: dict) -> gymnasium.envs.registration
     """The registered spec with the env options in its kwargs, so `gymnasium.make(spec)` (and
     Minari's `recover_environment`) builds the env the data came from.
 
-    `max_episode_steps` goes into the kwargs, to the env's own truncation, and not into the
-    spec's field of that name, which would add Gymnasium's `TimeLimit` wrapper instead.
+    A `max_episode_steps` option goes into the kwargs, the env's own truncation (what `make_vec`
+    builds with too), and into the spec's field, which `env.spec.max_episode_steps` shows and
+    whose `TimeLimit` ends episodes at the same step (`octax_gym.registration`).
     """
     spec = gymnasium.spec(gym_id)
-    return dataclasses.replace(spec, kwargs={**spec.kwargs, **env_options})
+    kwargs = {**spec.kwargs, **env_options}
+    bound = kwargs.get("max_episode_steps")
+    return dataclasses.replace(spec, kwargs=kwargs, max_episode_steps=spec.max_episode_steps if bound is None else bound)
 
 
 def episode_seed(dataset, episode_id: int) -> int:

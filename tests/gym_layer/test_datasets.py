@@ -98,7 +98,7 @@ def test_the_recovered_env_is_the_registered_one_with_the_collection_options(dat
     assert dataset.spec.env_spec.id == "octax/Brix-v0"
     assert dataset.spec.env_spec.kwargs == {"game": GAME, "max_episode_steps": MAX_STEPS}
     env = dataset.recover_environment()
-    assert env.spec.max_episode_steps is None  # the env's own truncation, no TimeLimit wrapper
+    assert env.spec.max_episode_steps == MAX_STEPS  # where the recovered env cuts episodes, as collected
     assert env.unwrapped.game_spec.id == GAME
     env.close()
 

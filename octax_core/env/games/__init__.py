@@ -3,11 +3,14 @@
 Modules are discovered, not listed, so adding a game is adding one module. A module may name its
 suite (`SUITE = "ours"`); without one its games are the octax paper's. A subpackage holds a suite
 of its own (`archive/`: the Chip8 Community Archive's games): its `__init__` names the suite, and
-its modules are discovered the same way. Lookups raise errors that name the valid ids (or suites).
+its modules are discovered the same way. A lookup of an unknown id raises `UnknownGameError`,
+naming the close matches ("did you mean 'Pong'?") rather than listing every id; an unknown suite
+lists the suites.
 """
 
 from __future__ import annotations
 
+import difflib
 import importlib
 import pkgutil
 from typing import Optional
@@ -23,6 +26,43 @@ SUITES = {
 }
 _REGISTRY: dict[str, GameSpec] = {}
 _SUITE_OF: dict[str, str] = {}
+MAX_SUGGESTIONS = 3  # close matches an unknown name's error names
+
+
+class UnknownGameError(KeyError, ValueError):
+    """No registered game has this id. The message names the close matches and where the
+    valid ids are listed, not the ids themselves: with the archive that list is a page long,
+    and the near miss is what a typo needs.
+
+    A KeyError, what a registry lookup raised before, and a ValueError, as the Gymnasium
+    layer's error for an unknown name (`octax_gym.UnknownOptionError`) is, so code catching
+    either keeps working.
+
+    Attributes:
+        game: the name given.
+        suggestions: the registered ids closest to it (at most `MAX_SUGGESTIONS`), best first.
+    """
+
+    def __init__(self, game, suggestions: tuple[str, ...] = ()):
+        self.game, self.suggestions = game, tuple(suggestions)
+        hint = f"; did you mean {' or '.join(map(repr, self.suggestions))}?" if self.suggestions else ""
+        super().__init__(f"unknown game {game!r}{hint} (see octax_core.list_games(), and "
+                         f"list_games(players=2) for the two-player games)")
+
+    def __str__(self) -> str:
+        return ValueError.__str__(self)  # not KeyError's, which would print the message as a repr
+
+
+def close_names(name, names, limit: int = MAX_SUGGESTIONS) -> list[str]:
+    """The `names` closest to `name`, best first, compared in any case ("pong" and "Pongg" both
+    give "Pong"); [] when none is close or `name` is not a str. Every layer's unknown-game error
+    suggests from this one function, so they name the same games."""
+    if not isinstance(name, str):
+        return []
+    lowered: dict[str, str] = {}
+    for candidate in names:
+        lowered.setdefault(candidate.lower(), candidate)
+    return [lowered[match] for match in difflib.get_close_matches(name.lower(), list(lowered), n=limit, cutoff=0.75)]
 
 
 def register(spec: GameSpec, suite: str = "octax") -> None:
@@ -71,7 +111,7 @@ def list_games(suite: Optional[str] = None, players: Optional[int] = None) -> li
 
 
 def suite_of(game_id: str) -> str:
-    """The suite a registered game belongs to (KeyError for an unknown id, as `get_spec`)."""
+    """The suite a registered game belongs to (`UnknownGameError` for an unknown id, as `get_spec`)."""
     get_spec(game_id)
     return _SUITE_OF[game_id]
 
@@ -80,15 +120,16 @@ def get_spec(game_id: str) -> GameSpec:
     """The `GameSpec` for `game_id`.
 
     Raises:
-        KeyError: unknown id; the message lists the valid ones.
+        UnknownGameError (a KeyError and a ValueError): no game has this id; the message names
+            the close matches.
     """
     try:
         return _REGISTRY[game_id]
-    except KeyError:
-        raise KeyError(f"unknown game {game_id!r}; valid ids: {', '.join(sorted(_REGISTRY))}") from None
+    except (KeyError, TypeError):  # TypeError: an unhashable id
+        raise UnknownGameError(game_id, close_names(game_id, _REGISTRY)) from None
 
 
 _discover()
 
-__all__ = ["CATEGORIES", "GameSpec", "SUITES", "Seats", "bcd_value", "get_spec", "in_routine", "key_mask", "list_games", "ram_value", "register",
-           "register_value", "suite_of"]
+__all__ = ["CATEGORIES", "GameSpec", "SUITES", "Seats", "UnknownGameError", "bcd_value", "close_names", "get_spec",
+           "in_routine", "key_mask", "list_games", "ram_value", "register", "register_value", "suite_of"]
