@@ -5,6 +5,7 @@ Nothing is emulated: both commands read `GameSpec`s, the `EnvConfig` defaults an
 
     octax-gym list [--category timing] [--suite ours]   every game: Gymnasium id, category, actions, ROM
     octax-gym info Pong                      one game in full (also `info octax/Pong-v0`)
+    octax-gym info my_game.ch8               a ROM file: what it plays as (16 keys, no reward)
 """
 
 from __future__ import annotations
@@ -12,6 +13,8 @@ from __future__ import annotations
 import argparse
 import sys
 import textwrap
+
+from octax_gym.cli.common import GAME_OR_ROM_HELP, game_or_rom
 
 WIDTH = 100  # `info` wraps its text to this many columns
 
@@ -26,7 +29,7 @@ def add_commands(commands: argparse._SubParsersAction) -> None:
     games.set_defaults(func=_cmd_list)
     info = commands.add_parser("info", help="one game: actions, spaces, quirks, timers, ROM",
                                description="Everything a game's spec says, without running it.")
-    info.add_argument("game", help='a game id ("Pong") or Gymnasium id ("octax/Pong-v0")')
+    info.add_argument("game", metavar="GAME|ROM", help=GAME_OR_ROM_HELP)
     info.set_defaults(func=_cmd_info)
 
 
@@ -73,16 +76,16 @@ def _cmd_info(args: argparse.Namespace) -> int:
     from octax_core.emulator.quirks import resolve_quirks
     from octax_gym import game_names
 
-    spec = game_names.resolve_spec(args.game)  # an unknown name: UnknownOptionError, exit status 1
+    spec, rom = game_or_rom(args.game)  # an unknown name: UnknownOptionError, exit status 1
     config = make_config(spec)[0]  # what gym.make / make_vec use by default (the game's own speed and timers)
     quirks = resolve_quirks(spec.quirks)
     platform = resolve_platform(spec.platform)
     screen = ", ".join(map(str, screen_values_shape(platform)))
     high = screen_values_max(platform, config.obs_scale)  # XO-CHIP: one value per plane combination
-    status = romstore.rom_status([spec])[0]
+    status = romstore.rom_status([spec])[0] if rom is None else None
     frames, steps_per_second = config.frames_per_step, 60 / config.frames_per_step
     fields = [
-        ("category", spec.category),
+        ("category", spec.category if rom is None else "none (a ROM file)"),
         ("description", spec.description),
         ("actions", f"Discrete({len(spec.action_keys) + 1}); action i holds its key for the whole step"),
         *[("", row) for row in _action_rows(spec.action_keys)],
@@ -99,16 +102,20 @@ def _cmd_info(args: argparse.Namespace) -> int:
         ("startup", (", then ".join(_startup_step(mask, n) for mask, n in spec.startup) or "none")
                     + "; run once at make, every reset starts there"),
         ("lives", "yes: info['lives'] counts them" if spec.lives_fn is not None else "no: info['lives'] is -1"),
-        ("rom", spec.rom_file),
+        ("rom", spec.rom_file if rom is None else str(rom)),
         ("rom sha1", spec.rom_sha1),
-        ("rom status", _rom_word(status) + (f" at {status.path}" if status.path else "")),
+        ("rom status", _rom_word(status) + (f" at {status.path}" if status.path else "") if rom is None
+                       else "a ROM file with no game spec: `octax-gym trace` ranks the registers that may hold "
+                            "its score"),
     ]
-    lines = [f"{spec.title}  ({game_names.env_id(spec)}, game id {spec.id!r}, version {spec.version})"]
+    heading = (f"{game_names.env_id(spec)}, game id {spec.id!r}, version {spec.version}" if rom is None
+               else f"the ROM file {str(rom)!r}")
+    lines = [f"{spec.title}  ({heading})"]
     for name, text in fields:
         lines.append(textwrap.fill(text, WIDTH, initial_indent=f"{name + ':' if name else '':19}",
                                    subsequent_indent=" " * 19, break_on_hyphens=False))
     print("\n".join(lines))
-    if not status.verified:
+    if status is not None and not status.verified:
         print(f"To fix: {romstore.FIX_HINT}.")
     return 0
 

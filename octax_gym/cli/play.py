@@ -4,6 +4,7 @@
     octax-gym play Duel --players human,scripted --open
     octax-gym play Brix --agent runs/brix/params.msgpack
     octax-gym play Brix --record octax/Brix-human-v0 --recorder alice
+    octax-gym play my_game.ch8                        # a ROM file: all 16 keys, no score
 
 Needs the `play` extra (aiohttp): pip install 'octax-gym[play]'. The server and JAX are imported
 only when the command runs.
@@ -16,7 +17,7 @@ import os
 import sys
 from pathlib import Path
 
-from octax_gym.cli.common import help_of  # noqa: F401  (the command modules' shared helpers)
+from octax_gym.cli.common import GAME_OR_ROM_HELP, game_or_rom, help_of  # noqa: F401  (help_of: shared helpers)
 
 PLAY_HINT = "pip install 'octax-gym[play]'"
 
@@ -27,7 +28,7 @@ def add_commands(commands: argparse._SubParsersAction) -> None:
         description="Starts a local web server where the env runs and prints its address: the page shows the "
                     "screen in the game's palette and takes the keyboard (Octo's layout: 1234/QWER/ASDF/ZXCV). "
                     "Needs the play extra: " + PLAY_HINT + ". See docs/play.md.")
-    play.add_argument("game", metavar="GAME", help="game id (Brix) or Gymnasium id; two-player games too (Duel)")
+    play.add_argument("game", metavar="GAME|ROM", help=GAME_OR_ROM_HELP + "; two-player games too (Duel)")
     play.add_argument("--port", type=int, default=0, metavar="N", help="port, 0..65535 (default 0: a free one)")
     play.add_argument("--host", default=None, metavar="H",
                       help="address to bind (default 127.0.0.1, this machine only; a loopback address keeps the "
@@ -71,17 +72,14 @@ def _cmd_play(args: argparse.Namespace) -> int:
         import aiohttp  # noqa: F401
     except ImportError as exc:
         raise ImportError(f"octax-gym play needs aiohttp (the play extra): {PLAY_HINT} ({exc})") from exc
-    import logging
-
-    from octax_gym.game_names import resolve_spec
     from octax_gym.play.hosts import is_loopback
     from octax_gym.play.server import PlayServer
     from octax_gym.play.session import Session, is_two_player
 
-    logging.basicConfig(level=logging.INFO, format="%(asctime)s %(name)s %(levelname)s %(message)s")
+    _log_octax_gym()
     if args.data_path is not None:
         os.environ["MINARI_DATASETS_PATH"] = str(args.data_path.expanduser().resolve())
-    spec = resolve_spec(args.game)
+    spec, rom = game_or_rom(args.game)
     two = is_two_player(spec)
     num_actions = len(spec.seats.action_keys[0] if two else spec.action_keys) + 1
     agent = None
@@ -94,6 +92,9 @@ def _cmd_play(args: argparse.Namespace) -> int:
     env_options = {} if args.max_episode_steps is None else {"max_episode_steps": args.max_episode_steps}
     recorder = None
     if args.record is not None:
+        if rom is not None:
+            raise ValueError("--record stores a registered game's episodes (the dataset rebuilds its env by id); "
+                             f"{rom} is a ROM file with no game spec")
         if two:
             raise ValueError("--record stores one-player games (the human's episodes of a one-player env); "
                              f"{spec.id} is a two-player game")
@@ -105,7 +106,9 @@ def _cmd_play(args: argparse.Namespace) -> int:
                             env_options=env_options)
         probe.close()
     print(f"compiling {spec.id} ...", file=sys.stderr)
-    session = Session(spec.id, seed=args.seed, agent=agent, players=players, recorder=recorder, **env_options)
+    if rom is not None:
+        env_options["rom"] = rom
+    session = Session(spec, seed=args.seed, agent=agent, players=players, recorder=recorder, **env_options)
     host = args.host or "127.0.0.1"
     if not is_loopback(host):  # the server then accepts any Host header: it must, to be reached by name
         print(f"octax-gym play: warning: binding {args.host}: anyone who can reach this address can play and "
@@ -127,3 +130,18 @@ def _cmd_play(args: argparse.Namespace) -> int:
             print(f"recorded {recorder.episodes} episode(s), {recorder.steps} steps, as {recorder.dataset_id} "
                   f"at {recorder.path}")
     return 0
+
+
+def _log_octax_gym() -> None:
+    """The server's log lines (the `octax_gym` loggers, INFO and up) on stderr, and nobody else's:
+    a root `logging.basicConfig(level=INFO)` would also print every library's INFO lines, JAX's
+    "Unable to initialize backend 'tpu'" probe on each start among them."""
+    import logging
+
+    logger = logging.getLogger("octax_gym")
+    logger.setLevel(logging.INFO)
+    if not any(getattr(handler, "octax_gym_play", False) for handler in logger.handlers):
+        handler = logging.StreamHandler(sys.stderr)
+        handler.setFormatter(logging.Formatter("%(asctime)s %(name)s %(levelname)s %(message)s"))
+        handler.octax_gym_play = True  # added once, however many times the command runs in a process
+        logger.addHandler(handler)

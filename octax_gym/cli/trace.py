@@ -6,8 +6,9 @@
 
 Plays the game with a random (or no-op) agent in a few envs (`octax_core.tools.trace.record_trace`),
 ranks V0..VF per role (`octax_core.tools.trace_rank.rank_registers`) and prints the best candidates
-with the evidence. A name that is not a game id is read as a ROM file with no spec: all 16 keys,
-"chip8" quirks, no start-up, no reward, episodes ending on a 2 s still screen. See docs/trace.md.
+with the evidence. A name that is not a game id is read as a ROM file with no spec
+(`octax_gym.cli.common.game_or_rom`): all 16 keys, the platform's quirks (.sc8 SUPER-CHIP, .xo8
+XO-CHIP, else CHIP-8), no start-up, no reward, episodes ending on a 2 s still screen. See docs/trace.md.
 """
 
 from __future__ import annotations
@@ -16,6 +17,7 @@ import argparse
 import csv
 from pathlib import Path
 
+from octax_gym.cli.common import GAME_OR_ROM_HELP, game_or_rom
 from octax_gym.policies import POLICIES
 
 MAX_PLOT_COLUMNS = 5  # --plot shows at most this many candidates per role
@@ -30,8 +32,7 @@ def add_commands(commands: argparse._SubParsersAction) -> None:
                     "every step and ranks them as score, lives and game-over candidates from their "
                     "trends, the ROM's code (FX33 etc.) and, for a registered game, its reward and "
                     "termination. See docs/trace.md.")
-    trace.add_argument("game", metavar="GAME|ROM",
-                       help="game id (Brix), Gymnasium id (octax/Brix-v0), or the path of a ROM file")
+    trace.add_argument("game", metavar="GAME|ROM", help=GAME_OR_ROM_HELP)
     trace.add_argument("--steps", type=int, default=2000, metavar="N", help="env steps per env (default 2000)")
     trace.add_argument("--policy", choices=tuple(POLICIES), default="random",
                        help="random (default) or noop (no key ever held)")
@@ -54,12 +55,10 @@ def _cmd_trace(args: argparse.Namespace) -> int:
             raise ValueError(f"--{name} must be >= 1, got {getattr(args, name)}")
     if args.plot is not None:
         _check_plot_path(args.plot)
-    from octax_core.tools.trace import raw_rom_spec, record_trace
+    from octax_core.tools.trace import record_trace
     from octax_core.tools.trace_rank import rank_registers
 
-    spec, rom = _resolve(args.game)
-    if rom is not None:
-        spec = raw_rom_spec(rom)
+    spec, rom = game_or_rom(args.game)
     trace = record_trace(spec, steps=args.steps, num_envs=args.envs, policy=args.policy, seed=args.seed,
                          blind=args.blind, rom=rom)
     ranking = rank_registers(trace)
@@ -72,24 +71,6 @@ def _cmd_trace(args: argparse.Namespace) -> int:
         _plot(trace, ranking, args.top, args.plot)
         print(f"wrote {args.plot}")
     return 0
-
-
-def _resolve(name: str):
-    """(spec, None) for a game id or Gymnasium id (any case); (None, path) for a ROM file.
-
-    Raises:
-        UnknownOptionError: neither; the message lists the valid ids.
-    """
-    from octax_gym.choices import UnknownOptionError
-    from octax_gym.game_names import resolve_spec
-
-    try:
-        return resolve_spec(name), None
-    except UnknownOptionError as unknown:
-        if Path(name).is_file():
-            return None, Path(name)
-        also = f"{unknown.also}, or the path of a ROM file (.ch8; there is no file {name!r})"
-        raise UnknownOptionError(unknown.what, name, unknown.choices, also) from None
 
 
 def _header(args: argparse.Namespace, trace, raw: bool) -> str:

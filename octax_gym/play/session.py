@@ -72,7 +72,8 @@ class Session:
     """A game, its seats and the episode in play.
 
     Args:
-        game: a game id ("Brix", "Duel"), Gymnasium id, any case.
+        game: a game id ("Brix", "Duel"), Gymnasium id, any case, or a `GameSpec` (with `rom=`
+            in `env_options` for a ROM file: `octax_gym.cli.common.game_or_rom`).
         seed: the first episode's seed, 0..2**32 - 1; episode e is seeded (seed + e) mod 2**32.
         agent: a function of one seat's observation -> action (`octax_gym.play.agents`), or None.
         players: each seat's player ("human", "agent", "scripted", "random"); default: a human
@@ -88,7 +89,7 @@ class Session:
         self.spec = resolve_spec(game)
         self.two_player = is_two_player(self.spec)
         cls = MultiAgentVectorEnv if self.two_player else OctaxVectorEnv
-        self.env = cls(self.spec.id, 1, autoreset_mode="disabled", **env_options)
+        self.env = cls(self.spec, 1, autoreset_mode="disabled", **env_options)  # the spec: a ROM file's too
         self.env_options = env_options
         core = self.env.core_env
         self.frames_per_step = core.config.frames_per_step

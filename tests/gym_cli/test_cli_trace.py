@@ -89,7 +89,8 @@ def _error(argv, capsys) -> str:
 def test_unknown_game_or_missing_file_lists_the_valid_ids(capsys):
     err = _error(["trace", "Nope"], capsys)
     assert "octax-gym: error: unknown game 'Nope'; valid: 'Airplane'" in err
-    assert "'Brix'" in err and "'Pong'" in err and "the path of a ROM file (.ch8; there is no file 'Nope')" in err
+    assert "'Brix'" in err and "'Pong'" in err
+    assert "the path of a ROM file (.ch8, .sc8, .xo8; there is no file 'Nope')" in err
     assert "unknown game 'missing.ch8'" in _error(["trace", "missing.ch8"], capsys)
 
 
