@@ -27,8 +27,14 @@ everywhere for first_0 and `obs_scale` for second_0. For a turn-based game (`Sea
 agent's observation is PettingZoo classic's dict instead, {"observation": that Box, "action_mask":
 int8 (n,)}, so that generic code (and PettingZoo's tests) sample legal actions; the mask opens
 no-op alone to the agent whose turn it is not. Every agent's info holds `action_mask` too (int8,
-every action open in a simultaneous game), with score (its seat's), lives, episode_step and
-current_player (the seat to move, -1 in a simultaneous game).
+every action open in a simultaneous game, what `action_space(agent).sample(mask=...)` takes), with
+score (its seat's), lives (its seat's, see below), episode_step and current_player (the seat to
+move, -1 in a simultaneous game).
+
+Lives: a game's `GameSpec.lives_fn` counts player 1's lives (the one-player env's, and seat 0's
+here), and `Seats` defines none per seat, so first_0's info has that count and second_0's -1,
+the value that says "no count kept" everywhere (as both have in a game without `lives_fn`),
+rather than player 1's count under player 2's name.
 
 Actions: Discrete(n), 0 = no key. Rewards: each seat's own (the change of its score).
 
@@ -63,6 +69,7 @@ from octax_gym.choices import check_choice
 from octax_gym.multi_vector import MultiAgentVectorEnv
 
 FIXED_KEYWORDS = ("autoreset_mode", "backend")  # PettingZoo steps one episode of numpy arrays
+NO_LIVES = -1  # info["lives"] of a seat whose lives the game does not count (as the envs' info says)
 OFF_TURN = ("ignore", "raise")
 
 
@@ -178,9 +185,10 @@ class OctaxParallelEnv(ParallelEnv):
 
     def _infos(self, info: dict, agents: list[str]) -> dict[str, dict]:
         masks = info["legal_action_mask"][0].astype(np.int8)
-        shared = {"lives": int(info["lives"][0]), "episode_step": int(info["episode_step"][0]),
-                  "current_player": int(info["current_player"][0])}
-        return {agent: {"score": float(info["score"][0, seat]), **shared, "action_mask": masks[seat]}
+        lives = (int(info["lives"][0]), NO_LIVES)  # per seat: `lives_fn` is player 1's (module docstring)
+        shared = {"episode_step": int(info["episode_step"][0]), "current_player": int(info["current_player"][0])}
+        return {agent: {"score": float(info["score"][0, seat]), "lives": lives[seat], **shared,
+                        "action_mask": masks[seat]}
                 for seat, agent in ((self.possible_agents.index(agent), agent) for agent in agents)}
 
     def _check_agent(self, agent: str) -> str:

@@ -310,7 +310,7 @@ class OctaxVectorEnv(gymnasium.vector.VectorEnv):
             raise gymnasium.error.ResetNeeded("call reset() before action_masks()")
         if self.view is None:
             return np.ones((self.num_envs, self.single_action_space.n), np.bool_)
-        return np.asarray(self._info["action_mask"])
+        return np.asarray(self._info["action_mask"], np.bool_)  # info's is int8, for Gymnasium's sample(mask=)
 
     @property
     def game(self) -> str:

@@ -198,8 +198,8 @@ def test_bad_overrides(rom_path, overrides, error, message):
         octax_core.make(COUNTER, rom=rom_path, **overrides)
 
 
-def test_unknown_game_lists_the_valid_ids():
-    with pytest.raises(KeyError, match="unknown game 'NoSuchGame'; valid ids"):
+def test_unknown_game_says_where_the_valid_ids_are():
+    with pytest.raises(KeyError, match=r"unknown game 'NoSuchGame' \(see octax_core.list_games\(\)"):
         octax_core.make("NoSuchGame")
 
 
