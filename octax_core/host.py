@@ -3,11 +3,10 @@
 XLA:CPU runs a step as a sequence of small kernels ("thunks") on a pool of one thread per core,
 handing ready kernels and the halves of large loops to the other threads. An emulator step is
 many kernels of a few microseconds each, so on a host with few cores the handoffs can cost more
-than the work they share: on the 2-core CI machine, with a one-thread pool, the same programs ran
-1.2x (CHIP-8, N = 64) to 1.5-1.8x (XO-CHIP, N = 64) faster, and at N = 512 5-30% slower (every
-platform gains from the second thread there; docs/machine.md, the same-program tables).
-Other work gains from the pool (the octax package's env ran 30% slower with one thread), so the
-pool keeps JAX's default unless asked.
+than the work they share: a small batch runs faster with a one-thread pool, while a large one
+gains from the second thread (its kernels are large enough for the split to pay), and so does
+other work with larger kernels, such as the octax package's env. So the pool keeps JAX's default
+unless asked (the measurements: docs/machine-log.md, "The thread pool").
 
 JAX offers no setting for it: XLA sizes the pool from the cores the process may run on when the
 CPU backend starts. `limit_cpu_threads` starts the backend while the process may run on

@@ -101,9 +101,9 @@ class Fetched(NamedTuple):
     kind: jax.Array  # int32 Kind; STALL while the frame is over (display wait)
     context: Context
     at_i: jax.Array  # uint8 bytes at I: the 16 of the window, 32 (a 16x16 sprite) on SUPER-CHIP, 64 (two) on
-    #                  XO-CHIP; as read, not widened, which the gated draws take as an input (`_Sprite`)
-    #                  and XLA then fills for every instruction: 4x the bytes in int32 (measured, 8% of a
-    #                  SUPER-CHIP instruction at N = 512)
+    #                  XO-CHIP; as read, not widened: the gated draws take it as an input (`_Sprite`), a
+    #                  buffer XLA fills on every instruction whether the gate runs or not, and int32 would
+    #                  make it 4x the bytes (measured: docs/machine-log.md)
 
 
 def fetch(platform: Platform, quirks: Quirks, state: MachineState, keys, stalled=None) -> Fetched:
@@ -210,8 +210,8 @@ def execute(platform: Platform, quirks: Quirks, state: MachineState, keys: jax.A
     # its sprite is the bytes fetched at I before the write (16, 32 on SUPER-CHIP, 64 for XO-CHIP's
     # two planes). DXYN writes no memory, so those are the bytes it would see after the write, and
     # nothing reads memory after the write: XLA never has to copy the memory buffer to keep the old
-    # version alive (a read of the old memory after the write cost a whole 64 KiB copy per
-    # instruction on XO-CHIP, measured).
+    # version alive (a read of the old memory after the write makes XLA copy the whole memory, 64 KiB
+    # on XO-CHIP, on every instruction).
     effects = {k: handler(c) for k, handler in handlers(platform).items()}
     defaults = _defaults(state, c)
     before_drawing = merge(kind, effects, defaults)  # all but DXYN's VF, which needs the collision
@@ -226,8 +226,9 @@ def _write_memory(platform: Platform, memory, effect: Effect, c: Context):
     """The merged effect's memory write: its first mem_count bytes at I, the rest unchanged.
 
     Few instructions write memory (FX33, FX55, XO-CHIP's 5XY2), so the write runs under
-    `when_any`: a batch in which no machine writes skips both window writes (+2-7% on every
-    platform, measured). A machine that writes nothing gets the bytes it has written back."""
+    `when_any`: a batch in which no machine writes, the common case, skips both window writes
+    (measured: docs/machine-log.md). A machine that writes nothing gets the bytes it has written
+    back."""
     lanes = jnp.arange(16, dtype=jnp.int32)
     written = jnp.where(lanes < effect.mem_count, effect.mem_data, c.window).astype(jnp.uint8)
     return when_any(effect.mem_count > 0, _write_window_at(platform), memory, (written, c.I))
@@ -310,8 +311,9 @@ class _Rare(NamedTuple):
 
     They cross into the gate packed in one uint32 (`_pack`, widths in `_RARE_BITS`): every
     separate input of a loop is a buffer XLA fills on every instruction, whether the loop runs
-    or not (one kernel each; XLA:CPU fills a stack of them row by row, then transposes it).
-    Measured as most of the gates' cost on a batch that never needs them."""
+    or not (one kernel each; XLA:CPU fills a stack of them row by row, then transposes it). On a
+    batch that never needs the gates, those fills are most of what the gates cost (measured:
+    docs/machine-log.md)."""
 
     needs: jax.Array  # `_Needs` as bits: 1 grid change, 2 screen scroll, 4 second plane, 8 hires sprite
     hires: jax.Array  # 1 in 128x64 mode (before this instruction), else 0
@@ -376,11 +378,10 @@ def _draw(platform: Platform, quirks: Quirks, state: MachineState, fetched: Fetc
     1 of such a machine as it is (it draws plane 2 at most). The order matters to XLA:CPU: read
     after the loop, the screen had two readers, the collision and plane 1's draw, that XLA could
     not order before the draw's in-place write, and it copied the screen before the loop on every
-    instruction (3 us with one thread and 14-19 with JAX's two at N = 512; without the copy
-    SUPER-CHIP and XO-CHIP run 1.3-1.7x faster there). CHIP-8 reads it the same way, before its
-    draw. Where the gate always runs (a GPU) there is no loop to copy for, and reading it first
-    made XO-CHIP 8-23% slower at N = 8,192 on an H100, so there it is read after the rare work
-    (`gate.where_looped` picks; see docs/machine.md).
+    instruction. CHIP-8 reads it the same way, before its draw. Where the gate always runs (a
+    GPU) there is no loop, so no copy to avoid, and the first order measured slower there, so
+    there it is read after the rare work (`gate.where_looped` picks). The copy's cost and the
+    GPU's timings: docs/machine-log.md.
     """
     c, n = fetched.context, fetched.fields.n
     if not platform.extended:

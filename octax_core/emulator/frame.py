@@ -188,7 +188,8 @@ def _finish(state, clock: Clock, record_screens: bool):
     """The state, and the pictures (None unless recorded). They come straight out of the loop, rows
     not run filled already (`_start`, `_fill_after`): a select here, after the loop, would be fused
     into the observation's unpack and its picture (a lores screen doubled, a hires choice)
-    recomputed for every pixel, 9x the whole observation's cost on XO-CHIP (measured)."""
+    recomputed for every pixel, which costs more than the rest of the observation (measured:
+    docs/machine-log.md)."""
     return state, (clock.screens if record_screens else None)
 
 

@@ -99,8 +99,8 @@ def detect(detector: Detector, state, count, dirty, target, instructions_per_fra
 
 # Instructions per loop step: the clock's bookkeeping is paid once per chunk. 12 is a multiple of
 # the periods of the usual spins (1: jump to self, 2: a key poll, 3: a timer wait, 4, 6), so a spin
-# repeats from one chunk's end to the next and is found two chunks after it starts; measured on
-# the archive's >= 200 ipf games at N = 64, 12 gave 3.6x where 8 gave 3.0x (docs/speed.md).
+# repeats from one chunk's end to the next and is found two chunks after it starts; a smaller
+# chunk pays the bookkeeping more often (12 against 8, measured: docs/machine-log.md).
 CHUNK = 12
 
 
@@ -108,7 +108,7 @@ def chunk_size(instructions_per_frame: int) -> int:
     """CHUNK, unless a busy frame would waste more than 3% of its slots in its last, partial chunk
     (a frame of 30 would run 3 chunks of 12: 36 slots): then the largest divisor of the frame
     length from 5 to 16, if there is one (30 -> 15, 100 -> 10). Larger chunks pay the clock less
-    often: at 30 instructions a frame, 15 measured 1.02x and 6 0.93x on a busy game at N = 512."""
+    often, so the largest divisor, not the smallest (measured: docs/machine-log.md)."""
     slots = -(-instructions_per_frame // CHUNK) * CHUNK
     if slots - instructions_per_frame <= 0.03 * instructions_per_frame:
         return min(CHUNK, instructions_per_frame)
@@ -117,6 +117,6 @@ def chunk_size(instructions_per_frame: int) -> int:
 
 
 # Below this many instructions per frame a frame holds too little to skip for the clock to pay
-# (Pong at 11: 0.92x, Carbon8 at 15: 0.84x, SuperPong at 30: 1.05x), and `Machine` runs the
-# plain lockstep loop, whose results are the same.
+# (the games measured on each side of it: docs/machine-log.md), and `Machine` runs the plain
+# lockstep loop, whose results are the same.
 SKIP_FROM = 25

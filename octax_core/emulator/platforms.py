@@ -51,14 +51,13 @@ class Platform:
         """`jax.jit(..., compiler_options=...)` for this platform's programs.
 
         Why: XLA:CPU's default copy insertion copies most of the instruction loop's registers on
-        every instruction (CHIP-8: 10 copies among 38 kernels at N = 512); its region analysis
-        proves those copies needless and drops them: +20-24% on CHIP-8, +10-30% on XO-CHIP, and
-        on SUPER-CHIP since its rare work went under one gate (before, it lost 8-22% with the
-        default two-thread pool, where the copies let independent kernels run side by side;
-        docs/machine.md has the numbers). As an
-        `XLA_FLAGS` flag it would set every program in the process, so it rides here, per
-        compile. It changes buffers, not results: tests/core_emulator/test_compiler_options.py
-        compares every step with and without it.
+        every instruction; its region analysis proves those copies needless and drops them, a
+        gain on every platform. SUPER-CHIP carries it since its rare work went under one gate:
+        before, with a multi-thread pool, the copies let its independent kernels run side by
+        side, and dropping them lost more than the copies cost (docs/machine-log.md has the
+        numbers). As an `XLA_FLAGS` flag it would set every program in the process, so it rides
+        here, per compile. It changes buffers, not results:
+        tests/core_emulator/test_compiler_options.py compares every step with and without it.
         """
         return dict(self.xla_options)
 

@@ -245,8 +245,7 @@ def unpack_screen(screen, on=True, dtype=jnp.bool_):
     `(word >> (31 - x)) & 1`: the lane index x is a bare iota, which XLA keeps inside the fused
     loop as a constant vector. `31 - x` is arithmetic on an iota, which XLA's loop-invariant code
     motion hoists out of a `lax.scan` body; the fused unpack then reads the shifts from memory and
-    XLA:CPU compiles it to a scalar loop, measured 5x slower on its own (the env scan of
-    benchmarks/env_loop.py ran at 0.53x of the bare machine instead of 0.85x).
+    XLA:CPU compiles it to a scalar loop instead of vector code (its cost: docs/machine-log.md).
     """
     xp = np if isinstance(screen, np.ndarray) else jnp
     lanes = xp.arange(32, dtype=xp.uint32)

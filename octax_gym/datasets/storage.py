@@ -12,8 +12,8 @@ The file is Minari's: the same groups (`episode_<id>` with its `id`, `seed` and 
 attributes; `observations`, `actions`, `rewards`, `terminations`, `truncations`; `infos/...`),
 the same metadata.json, `data_format: "hdf5"`, so `minari.load_dataset` and any HDF5 tool read it
 unchanged and bit for bit: nothing here to decode. The metadata's `observation_filters` says how
-the observations are stored. Brix random play: 9,377 bytes a step written by Minari, about 125
-here (benchmarks/datasets.py).
+the observations are stored. A random-play dataset comes out dozens of times smaller than
+Minari's writer makes it (benchmarks/README.md, datasets.py, has the sizes).
 
 A collection can be killed at any instant (a cluster's preemption, SIGKILL, Ctrl-C) and leave a
 readable dataset of the episodes it had written, or no dataset, never a damaged one. Every file is
@@ -56,8 +56,9 @@ from octax_gym.datasets.diskwrite import DatasetWriteError, HDF5Writing, is_out_
 INSTALL_HINT = 'pip install "octax-gym[datasets]"'
 
 # h5py's create_dataset filter arguments for the observations. scaleoffset=0: the fewest bits each
-# chunk's integers need, found per chunk; deflate level 1 compresses within a few percent of level 9
-# at several times its speed on these frames (benchmarks/datasets.py).
+# chunk's integers need, found per chunk. Deflate level 1, the fastest: collection writes while it
+# runs, and a higher level buys a somewhat smaller file with a slower collection (measured:
+# benchmarks/README.md, datasets.py).
 OBSERVATION_FILTERS = {"scaleoffset": 0, "compression": "gzip", "compression_opts": 1}
 FILTERS_NAME = "scaleoffset+gzip1"
 CHUNK_STEPS = 64  # observations per HDF5 chunk (the unit compressed and read back together)
@@ -130,7 +131,8 @@ class DatasetWriter:
         metadata: Minari's metadata arguments (algorithm_name, author, description, ...); None
             values are left out.
         extra_metadata: more keys for metadata.json (the policy card of a suite dataset, say).
-        compress: False writes the observations without filters (faster to read, ~70x larger).
+        compress: False writes the observations without filters: faster to read, but every
+            zero and repeated pixel is stored (sizes: benchmarks/README.md, datasets.py).
     """
 
     def __init__(self, dataset_id: str, env_spec, observation_space, action_space, flush_steps: int,

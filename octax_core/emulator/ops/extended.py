@@ -87,7 +87,7 @@ def op_5xy3(c: Context) -> Effect:
     """LOAD Vx..Vy: V[x +/- k] = memory[I + k]; I does not move."""
     lanes, in_range = _range(c)
     # lane r reads byte |r - x|: chosen among the 16 by selects, not gathered (a gather inside the
-    # fused register update keeps XLA:CPU from vectorising it: 2x that kernel's time, measured)
+    # fused register update keeps XLA:CPU from vectorising that kernel; measured: docs/machine-log.md)
     distance = jnp.abs(lanes - c.x)
     values = c.window[0]
     for k in range(1, 16):
