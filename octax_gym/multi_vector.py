@@ -18,13 +18,12 @@ import inspect
 from typing import Any, Optional, Union
 
 import gymnasium
-import jax
 import numpy as np
 from gymnasium import spaces
 from gymnasium.vector import AutoresetMode
 
 from octax_core.env.config import check_option_names
-from octax_gym import action_check, render
+from octax_gym import render
 from octax_gym.compiled_step import GYM_ENV_OPTIONS
 from octax_gym.vector import OctaxVectorEnv
 
@@ -107,20 +106,6 @@ class MultiAgentVectorEnv(OctaxVectorEnv):
         if self._info is None:
             raise gymnasium.error.ResetNeeded("call reset() before action_masks()")
         return np.asarray(self._info["legal_action_mask"])
-
-    def _actions_to_device(self, actions) -> tuple[jax.Array, bool]:
-        """(num_envs, 2) actions checked and on the device; host ones against the legal mask too."""
-        host = not isinstance(actions, jax.Array) and action_check._torch_if_tensor(actions) is None
-        if host:
-            array = action_check.check_batch(actions, self.num_envs, self.num_actions, self.game_spec.id,
-                                             agents=self.agents)
-            if self.turn_based:
-                action_check.check_legal(array, np.asarray(self._info["legal_action_mask"]),
-                                         np.asarray(self._info["current_player"]), self.game_spec.id, self.agents,
-                                         skip=np.asarray(self._state.done))
-            return jax.device_put(array.astype(np.int32), self.device), False
-        return action_check.to_device(actions, self.num_envs, self.num_actions, self.device, self.game_spec.id,
-                                      self.agents)
 
 
 def make_multi_vec(game: Any, num_envs: int = 1, **kwargs) -> MultiAgentVectorEnv:

@@ -64,7 +64,7 @@ import numpy as np
 from gymnasium import spaces
 from pettingzoo import AECEnv, ParallelEnv
 
-from octax_gym.action_check import to_host
+from octax_gym.action_check import to_int
 from octax_gym.choices import check_choice
 from octax_gym.multi_vector import MultiAgentVectorEnv
 
@@ -140,11 +140,7 @@ class OctaxParallelEnv(ParallelEnv):
                 if mover < 0 or seat == mover:
                     raise ValueError(f"{self.game_spec.id}: no action for {agent}; give one for each of {self.agents}")
                 continue
-            value = np.asarray(to_host(actions[agent]))
-            if value.shape != () or not np.issubdtype(value.dtype, np.integer) or value.dtype == np.bool_:
-                raise TypeError(f"{self.game_spec.id}: {agent}'s action is one integer in 0..{self.num_actions - 1}, "
-                                f"got {value.dtype} of shape {value.shape}")
-            row[0, seat] = value
+            row[0, seat] = to_int(actions[agent], self.num_actions, self.game_spec.id, agent)
         if self.turn_based and self.off_turn == "ignore" and mover >= 0:
             row[0, 1 - mover] = 0  # the other seat's action, ignored (PettingZoo's turn-based parallel convention)
         obs, reward, terminated, truncated, info = self.vector_env.step(row)

@@ -236,12 +236,12 @@ class OctaxVectorEnv(gymnasium.vector.VectorEnv):
         """
         if self._state is None:
             raise gymnasium.error.ResetNeeded("call reset() before step()")
-        actions, unchecked = self._actions_to_device(actions)
+        given = self._actions_to_device(actions)
         self._action_check.poll()
         extra = () if self._opponent is None else (self._opponent_actions(),)
         self._keys, self._obs, self._state, reward, terminated, truncated, info, report = self._step_fn(
-            self._keys, self._state, actions, self._action_check.report, self.params, *extra)
-        self._action_check.record(report, unchecked)
+            self._keys, self._state, given.actions, self._action_check.report, self.params, *extra)
+        self._action_check.record(report, given.unchecked, given.given)
         obs, reward, terminated, truncated, info = self._local((self._obs, reward, terminated, truncated, info))
         self._info = info
         out = backends.to_backend((obs, reward, terminated, truncated, info), self.backend)
@@ -275,24 +275,25 @@ class OctaxVectorEnv(gymnasium.vector.VectorEnv):
         """The step's outputs as this process's rows (with `devices=`; as they are otherwise)."""
         return tree if self._shards is None else self._shards.to_local(tree)
 
-    def _actions_to_device(self, actions) -> tuple[jax.Array, bool]:
-        """The step's actions checked (`octax_gym.action_check`) and on the device; against an
-        opponent, host actions are checked against the learner's `action_mask` too. With
-        `devices=` they are read to the host, checked there, and placed into the global batch."""
+    def _actions_to_device(self, actions) -> action_check.DeviceActions:
+        """The step's actions checked (`action_check.to_device`: (num_envs,), or (num_envs, 2) in a
+        `MultiAgentVectorEnv`) and on the device; host ones against a turn-based game's legal mask
+        too. With `devices=` they are read to the host, checked there, and placed into the global batch."""
         if self._shards is not None:
             host = action_check.check_batch(action_check.to_host(actions), self.num_envs,
                                             self.single_action_space.n, self.game_name)
-            return self._shards.to_global(host.astype(np.int32)), False
-        actions, unchecked = action_check.to_device(actions, self.num_envs, self.single_action_space.n,
-                                                    self.device, self.game_name)
-        if self.view is not None and self.core_env.turn_based and not unchecked:
-            both = np.zeros((self.num_envs, 2), np.int32)
-            both[:, self.view.seat] = np.asarray(actions)
-            legal = np.ones((self.num_envs, 2, self.single_action_space.n), np.bool_)
-            legal[:, self.view.seat] = np.asarray(self._info["action_mask"])
-            action_check.check_legal(both, legal, np.asarray(self._info["current_player"]), self.game_spec.id,
-                                     self.agents, skip=np.asarray(self._state.done))
-        return actions, unchecked
+            return action_check.DeviceActions(self._shards.to_global(host.astype(np.int32)), False)
+        turn_based = self.agents is not None and self.core_env.turn_based  # agents: a two-player core env
+        return action_check.to_device(actions, self.num_envs, self.core_env.num_actions, self.device, self.game_name,
+                                      self.agents if self.view is None else None, self._turns if turn_based else None)
+
+    def _turns(self) -> action_check.Turns:
+        """A turn-based game's state after the last step, on the host: the legal mask of both seats
+        (`MultiAgentVectorEnv`) or of the learner's against an opponent."""
+        info = self._info
+        legal = info["legal_action_mask"] if self.view is None else info["action_mask"]
+        return action_check.Turns(np.asarray(legal), np.asarray(info["current_player"]), np.asarray(self._state.done),
+                                  self.agents, None if self.view is None else self.view.seat)
 
     def _opponent_actions(self) -> jax.Array:
         """A function opponent's actions for this step, from its own observation (the learner's

@@ -83,6 +83,11 @@ class Env:
         return len(self._action_masks)
 
     @property
+    def name(self) -> str:
+        """What this env's errors call it: its game's id."""
+        return self.spec.id
+
+    @property
     def observation_shape(self) -> tuple[int, int, int]:
         return (self.config.frames_per_step, *screen_values_shape(self.machine.platform))
 
@@ -229,17 +234,36 @@ class Env:
         return jnp.asarray(self.spec.lives_fn(machine), jnp.int32)
 
     def _check_action(self, action) -> jax.Array:
-        if not isinstance(action, jax.core.Tracer):
-            value = np.asarray(action)
-            if value.shape != () or not np.issubdtype(value.dtype, np.integer):
-                raise TypeError(f"{self.spec.id}: an action is one integer, got {value.dtype} of shape {value.shape}")
-            if not 0 <= int(value) < self.num_actions:
-                raise ValueError(f"{self.spec.id}: action {int(value)} is out of range; valid actions are "
-                                 f"0..{self.num_actions - 1} (0 = no-op, keys {list(self.spec.action_keys)})")
-        # A traced action cannot be checked here: out-of-range values hold no key (documented).
-        # octax_gym checks every action before or inside its jitted step and raises.
-        action = jnp.asarray(action, jnp.int32)
-        return jnp.where((action >= 0) & (action < self.num_actions), action, 0)
+        """The step's action(s), of shape `_action_shape` (one per seat in a `MultiEnv`), as int32.
+
+        The one action check of the core, for every env kind. A concrete action is checked here:
+        TypeError for a wrong shape or a non-integer dtype, ValueError naming the first value
+        outside 0..num_actions-1. A traced one is checked for shape and dtype (static), not for
+        values: under `jit` nothing can be raised, so an out-of-range value holds no key (no-op);
+        octax_gym checks every action before or inside its jitted step and raises. The range is
+        tested in the action's own dtype and only then narrowed: narrowing first would wrap a wide
+        value (int64 2**32 + 1 under `jax_enable_x64`) onto a valid action (1).
+        """
+        traced = isinstance(action, jax.core.Tracer)
+        value = action if traced else np.asarray(action)
+        if value.shape != self._action_shape or not jnp.issubdtype(value.dtype, jnp.integer):
+            raise TypeError(f"{self.name}: {self._action_form()}; got {value.dtype} of shape {value.shape}")
+        if not traced:
+            bad = np.argwhere((value < 0) | (value >= self.num_actions))
+            if len(bad):
+                where = tuple(bad[0])
+                seat = f" of seat {self.agents[where[0]]}" if where else ""
+                raise ValueError(f"{self.name}: action {int(value[where])}{seat} is out of range; valid actions are "
+                                 f"0..{self.num_actions - 1} (0 = no-op)")
+        action = jnp.asarray(action)
+        return jnp.where((action >= 0) & (action < self.num_actions), action, 0).astype(jnp.int32)
+
+    def _action_form(self) -> str:
+        """What a step takes, for `_check_action`'s TypeError (only a `MultiEnv` has seats)."""
+        if not self._action_shape:
+            return f"an action is one integer in 0..{self.num_actions - 1}"
+        return (f"actions are {self._action_shape[0]} integers, one per seat ({', '.join(self.agents)}), "
+                f"each in 0..{self.num_actions - 1}")
 
 
 def _play(machine: Machine, frames_per_step: int, freeze_timers: bool, state: MachineState, keys, halted=None,

@@ -102,6 +102,11 @@ class MixEnv(Env):
         return len(self.specs)
 
     @property
+    def name(self) -> str:
+        """What this env's errors call it: mix(its games); action i is each game's own action i."""
+        return f"mix({', '.join(self.games)})"
+
+    @property
     def default_params(self) -> EnvParams:
         """max_episode_steps per game (each game's own unless `make_mix` was told one for all)."""
         return self._params
@@ -165,17 +170,6 @@ class MixEnv(Env):
 
     def _survival_reward(self, game):
         return jnp.asarray(self._survival)[game] if self._survival.any() else None
-
-    def _check_action(self, action) -> jax.Array:
-        if not isinstance(action, jax.core.Tracer):
-            value = np.asarray(action)
-            if value.shape != () or not np.issubdtype(value.dtype, np.integer):
-                raise TypeError(f"mix: an action is one integer, got {value.dtype} of shape {value.shape}")
-            if not 0 <= int(value) < self.num_actions:
-                raise ValueError(f"mix: action {int(value)} is out of range; valid actions are 0..{self.num_actions - 1} "
-                                 "(the largest game's; info['action_mask'] has each env's)")
-        action = jnp.asarray(action, jnp.int32)
-        return jnp.where((action >= 0) & (action < self.num_actions), action, 0)
 
 
 def _check_specs(specs: Sequence[GameSpec], roms) -> None:

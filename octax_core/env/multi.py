@@ -131,20 +131,6 @@ class MultiEnv(Env):
             raise ValueError(f"{self.spec.id}: Seats.score_fn must give ({self.players},) scores, got {scores.shape}")
         return scores
 
-    def _check_action(self, actions) -> jax.Array:
-        if not isinstance(actions, jax.core.Tracer):
-            value = np.asarray(actions)
-            if value.shape != (self.players,) or not np.issubdtype(value.dtype, np.integer):
-                raise TypeError(f"{self.spec.id}: actions are {self.players} integers, one per seat "
-                                f"({', '.join(self.agents)}); got {value.dtype} of shape {value.shape}")
-            if ((value < 0) | (value >= self.num_actions)).any():
-                raise ValueError(f"{self.spec.id}: actions {value.tolist()} out of range; each seat's actions are "
-                                 f"0..{self.num_actions - 1} (0 = no-op)")
-        elif jnp.shape(actions) != (self.players,):
-            raise TypeError(f"{self.spec.id}: actions must have shape ({self.players},), got {jnp.shape(actions)}")
-        actions = jnp.asarray(actions, jnp.int32)
-        return jnp.where((actions >= 0) & (actions < self.num_actions), actions, 0)
-
 
 def make_multi(game: Union[str, GameSpec], *, rom=None, **options: Any) -> tuple[MultiEnv, EnvParams]:
     """Builds the two-player env of a game in `list_games(players=2)` (or your `GameSpec` with seats).

@@ -3,6 +3,7 @@ is worked by hand: holding key 1 for a 4-frame step scores 4, the game is over w
 """
 
 import jax
+import jax.numpy as jnp
 import numpy as np
 import pytest
 
@@ -10,6 +11,7 @@ import octax_core
 from octax_core.env.testing import check_env
 
 from counter_game import COUNTER, COUNTER_ROM, GOAL
+from two_player_games import TWO_COUNTERS, TWO_COUNTERS_ROM
 
 
 @pytest.fixture(scope="module")
@@ -182,6 +184,64 @@ def test_bad_actions_are_refused(counter):
         env.step(jax.random.key(0), state, 3, params)
     with pytest.raises(TypeError, match="one integer"):
         env.step(jax.random.key(0), state, 1.0, params)
+
+
+@pytest.fixture(scope="module")
+def env_kinds(rom_path):
+    """One env of each kind, each with its seats' action shape: one player, two seats, a mix."""
+    two = rom_path.parent / "two_counters.ch8"
+    two.write_bytes(TWO_COUNTERS_ROM)
+    kinds = {"one player": octax_core.make(COUNTER, rom=rom_path),
+             "two seats": octax_core.make_multi(TWO_COUNTERS, rom=two),
+             "mix": octax_core.make_mix([COUNTER, COUNTER], roms=[rom_path, rom_path])}
+    return {kind: (env, params, env.reset(jax.random.key(0), params)[1]) for kind, (env, params) in kinds.items()}
+
+
+def _seated(env, value):
+    """`value` as the env's step takes it: alone, or in the second seat's place (seat 0 plays 1)."""
+    return value if not env._action_shape else np.array([1, value], np.asarray(value).dtype)
+
+
+@pytest.mark.parametrize("kind, name", [("one player", "Counter"), ("two seats", "TwoCounters"),
+                                        ("mix", r"mix\(Counter, Counter\)")])
+@pytest.mark.parametrize("value", [np.int64(2**32 + 1), np.int64(-2**32 + 1), 2**32 + 1, np.uint64(2**63), 3, -1])
+def test_every_kind_refuses_an_out_of_range_action_by_its_value(env_kinds, kind, name, value):
+    """One check for all three kinds: the value as given is compared, never a narrowed one."""
+    env, params, state = env_kinds[kind]
+    seat = " of seat second_0" if kind == "two seats" else ""
+    message = rf"^{name}: action {int(value)}{seat} is out of range; valid actions are 0\.\.2 \(0 = no-op\)$"
+    with pytest.raises(ValueError, match=message):
+        env.step(jax.random.key(0), state, _seated(env, value), params)
+    form = r"actions are 2 integers, one per seat \(first_0, second_0\), each" if kind == "two seats" else \
+        "an action is one integer"
+    with pytest.raises(TypeError, match=rf"^{name}: {form} in 0\.\.2; got float32"):
+        env.step(jax.random.key(0), state, _seated(env, np.float32(1)), params)
+    with pytest.raises(TypeError, match=r"got int64 of shape \(3,\)"):
+        env.step(jax.random.key(0), state, np.zeros(3, np.int64), params)
+    np.testing.assert_array_equal(env._check_action(_seated(env, np.int64(2))), _seated(env, 2))
+
+
+@pytest.mark.parametrize("kind", ["one player", "two seats", "mix"])
+def test_a_traced_wide_action_is_range_checked_before_it_is_narrowed(env_kinds, kind):
+    """Under jax_enable_x64 an int64 2**32 + 1 is out of range, so no-op (0); narrowed to int32
+    first it would have wrapped to 1, a valid key."""
+    env, _, _ = env_kinds[kind]
+    with jax.enable_x64(True):
+        check = jax.jit(env._check_action)
+        for value, expected in ((2**32 + 1, 0), (-2**32 + 1, 0), (2, 2), (3, 0)):
+            action = check(jnp.asarray(_seated(env, value), jnp.int64))
+            assert action.dtype == jnp.int32
+            np.testing.assert_array_equal(action, _seated(env, expected))
+    with pytest.raises(TypeError, match="got float32"):
+        jax.jit(env._check_action)(jnp.asarray(_seated(env, 1.0), jnp.float32))
+
+
+def test_the_check_is_the_base_env_s_alone():
+    """MultiEnv and MixEnv differ in action shape and name, not in how an action is checked."""
+    from octax_core.env.mix import MixEnv
+    from octax_core.env.multi import MultiEnv
+
+    assert [kind.__name__ for kind in (MultiEnv, MixEnv) if "_check_action" in vars(kind)] == []
 
 
 @pytest.mark.parametrize("overrides, error, message", [

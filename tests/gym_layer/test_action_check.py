@@ -68,7 +68,7 @@ def test_jax_actions_are_never_read_on_the_step_path(make_envs, monkeypatch):
     assert not actions.is_ready(), "step() waited for the actions' computation"
     # The reports themselves, not the state: a report is read once it is ready, and on CI's CPU the
     # state came out ready while the first report did not yet (the error then came one call later).
-    jax.block_until_ready([report for _, report in envs._action_check._pending])
+    jax.block_until_ready([report for _, report, _ in envs._action_check._pending])
     with pytest.raises(InvalidActionError, match=r"action 9 is out of range; valid actions are 0\.\.2 \(env 2"):
         envs.step(jnp.array([0, 0, 0]))
     obs, reward, *_ = envs.step(jnp.array([2, 2, 2]))  # after the error, a clean report
@@ -173,8 +173,8 @@ def test_out_of_range_is_one_error_type_on_the_host_and_the_device():
         to_int(3, 3, "Game")
     with pytest.raises(InvalidActionError, match=r"^Game: action 5 is out of range; valid actions are 0\.\.2$"):
         to_device(np.array([0, 5]), 2, 3, jax.devices()[0], "Game")
-    actions, unchecked = to_device(jnp.array([0, 5]), 2, 3, jax.devices()[0], "Game")
-    assert unchecked and actions.dtype == jnp.int32  # its range: the step's report (above)
+    given = to_device(jnp.array([0, 5]), 2, 3, jax.devices()[0], "Game")
+    assert given.unchecked and given.actions.dtype == jnp.int32  # its range: the step's report (above)
 
 
 def test_the_envs_check_actions_only_through_this_module(counter_rom, monkeypatch):
@@ -200,3 +200,153 @@ def test_no_other_module_of_the_user_layer_words_an_action_check():
     modules = sorted(path.relative_to(package).as_posix() for path in package.rglob("*.py")
                      if any(words in path.read_text() for words in wording))
     assert modules == ["action_check.py"]
+
+
+# --- values beyond int32: the range is checked before any narrowing, in every backend and view ---
+
+BACKENDS = ("numpy", "jax", "torch")
+KINDS = ("numpy", "torch", "jax")  # how the actions come: host array, torch tensor, JAX array (int64)
+BAD = (2**32 + 1, -2**32 + 1, 3, -1)  # the two that wrapped onto 1 (narrowed first), and ordinary ones
+
+
+def _int64(kind, values):
+    """`values` as int64 actions of a kind; a JAX int64 array needs jax_enable_x64 to be made."""
+    if kind == "numpy":
+        return np.asarray(values, np.int64)
+    if kind == "torch":
+        torch = pytest.importorskip("torch", reason="the torch extra is installed by `make test`")
+        return torch.tensor(values, dtype=torch.int64)
+    with jax.enable_x64(True):
+        return jnp.asarray(values, jnp.int64)
+
+
+def _refused(envs, actions, message):
+    """Steps `actions` and expects `message`: from this step (host actions, numpy backend) or, for
+    device actions on the jax and torch backends, from `close()`; returns the step's rewards then."""
+    rewards = None
+    with pytest.raises(InvalidActionError, match=message):
+        rewards = np.asarray(envs.step(actions)[1])
+        envs.close()
+    return rewards
+
+
+@pytest.fixture(scope="module")
+def two_counters_rom(tmp_path_factory):
+    from two_player_games import TWO_COUNTERS_ROM
+
+    path = tmp_path_factory.mktemp("two_counters") / "two_counters.ch8"
+    path.write_bytes(TWO_COUNTERS_ROM)
+    return path
+
+
+@pytest.mark.parametrize("backend", BACKENDS)
+@pytest.mark.parametrize("kind", KINDS)
+@pytest.mark.parametrize("value", BAD)
+@pytest.mark.parametrize("view", ["vector", "mix"])
+def test_a_vector_env_refuses_an_out_of_range_action_of_any_width(counter_rom, monkeypatch, backend, kind, value, view):
+    if view == "mix":  # a one-game mix of Counter: its ROM from the store's search path
+        monkeypatch.setenv("OCTAX_ROM_DIR", str(counter_rom.parent))
+        envs = OctaxVectorEnv([COUNTER], 3, backend=backend)
+    else:
+        envs = OctaxVectorEnv(COUNTER, 3, rom=counter_rom, backend=backend)
+    envs.reset(seed=0)
+    rewards = _refused(envs, _int64(kind, [2, value, 1]), rf"action {value} is out of range; valid actions are 0\.\.2")
+    if rewards is not None:  # it ran: the bad row held no key (wrapped to 1, it would have scored 4)
+        assert rewards.tolist() == [8.0, 0.0, 4.0]
+    envs.reset(seed=0)
+    assert np.asarray(envs.step(_int64(kind, [2, 1, 0]))[1]).tolist() == [8.0, 4.0, 0.0]
+
+
+@pytest.mark.parametrize("backend", BACKENDS)
+@pytest.mark.parametrize("kind", KINDS)
+@pytest.mark.parametrize("value", BAD)
+def test_the_multi_agent_env_refuses_an_out_of_range_action_of_any_width(two_counters_rom, backend, kind, value):
+    from two_player_games import TWO_COUNTERS
+
+    envs = octax_gym.MultiAgentVectorEnv(TWO_COUNTERS, 3, rom=two_counters_rom, backend=backend)
+    envs.reset(seed=0)
+    rewards = _refused(envs, _int64(kind, [[1, 0], [0, value], [2, 2]]),
+                       rf"action {value} is out of range; valid actions are 0\.\.2 \(env 1, seat second_0")
+    if rewards is not None:
+        assert rewards.tolist() == [[4.0, 0.0], [0.0, 0.0], [8.0, 8.0]]
+    envs.reset(seed=0)
+    assert np.asarray(envs.step(_int64(kind, [[1, 0], [0, 1], [2, 2]]))[1]).tolist() == [[4, 0], [0, 4], [8, 8]]
+
+
+@pytest.mark.parametrize("backend", BACKENDS)
+@pytest.mark.parametrize("kind", KINDS)
+@pytest.mark.parametrize("value", BAD)
+def test_one_seat_against_an_opponent_refuses_an_out_of_range_action_of_any_width(two_counters_rom, backend, kind,
+                                                                                  value):
+    from two_player_games import TWO_COUNTERS
+
+    envs = OctaxVectorEnv(TWO_COUNTERS, 3, rom=two_counters_rom, backend=backend, opponent="noop", seat=1)
+    envs.reset(seed=0)
+    rewards = _refused(envs, _int64(kind, [2, value, 1]), rf"action {value} is out of range; valid actions are 0\.\.2")
+    if rewards is not None:
+        assert rewards.tolist() == [8.0, 0.0, 4.0]
+
+
+@pytest.mark.parametrize("backend", BACKENDS)
+@pytest.mark.parametrize("kind", ("int",) + KINDS)
+@pytest.mark.parametrize("value", BAD)
+def test_the_single_env_refuses_an_out_of_range_action_of_any_width(counter_rom, backend, kind, value):
+    env = octax_gym.OctaxEnv(COUNTER, rom=counter_rom, backend=backend)
+    env.reset(seed=0)
+    action = value if kind == "int" else _int64(kind, value)
+    message = rf"^Counter: action {value} is out of range; valid actions are 0\.\.2$"
+    with pytest.raises(InvalidActionError, match=message):
+        env.step(action)
+    assert env.step(2 if kind == "int" else _int64(kind, 2))[1] == 8.0
+
+
+@pytest.mark.parametrize("kind", ("int",) + KINDS)
+@pytest.mark.parametrize("value", BAD)
+def test_pettingzoo_refuses_an_out_of_range_action_of_any_width(two_counters_rom, kind, value):
+    pytest.importorskip("pettingzoo")
+    from octax_gym import pettingzoo as octax_pz
+    from two_player_games import TWO_COUNTERS
+
+    env = octax_pz.parallel_env(TWO_COUNTERS, rom=two_counters_rom)
+    env.reset(seed=0)
+    action = value if kind == "int" else _int64(kind, value)
+    with pytest.raises(InvalidActionError, match=rf"action {value} is out of range; valid actions are 0\.\.2 "
+                                                 r"\(seat second_0\)$"):
+        env.step({"first_0": 1, "second_0": action})
+    _, rewards, *_ = env.step({"first_0": 1, "second_0": 2 if kind == "int" else _int64(kind, 2)})
+    assert rewards == {"first_0": 4.0, "second_0": 8.0}
+
+
+@pytest.mark.parametrize("dtype", ["uint32", "uint64"])
+def test_unsigned_device_actions_are_named_by_their_value(make_envs, dtype):
+    """uint32 2**32 - 1 once read as -1 (int32), and a torch uint64 has no clamp of its own."""
+    torch = pytest.importorskip("torch", reason="the torch extra is installed by `make test`")
+    envs = make_envs("torch")
+    envs.reset(seed=0)
+    with pytest.raises(InvalidActionError, match=rf"action {2**32 - 1} is out of range"):
+        envs.step(torch.tensor([0, 2**32 - 1, 1], dtype=getattr(torch, dtype)))
+        envs.close()
+    envs.reset(seed=0)
+    with pytest.raises(InvalidActionError, match=rf"action {2**32 - 1} is out of range"):
+        envs.step(jnp.asarray([0, 2**32 - 1, 1], jnp.uint32))
+        envs.close()
+
+
+def test_the_first_bad_step_s_value_is_named_after_clean_ones(make_envs):
+    """Several steps pending: the error names the first bad action as given, not a later one's."""
+    torch = pytest.importorskip("torch", reason="the torch extra is installed by `make test`")
+    envs = make_envs("jax")
+    envs.reset(seed=0)
+    message = rf"action {2**40} is out of range; valid actions are 0\.\.2 \(env 1, "
+    with pytest.raises(InvalidActionError, match=message):
+        for actions in ([0, 1, 2], [0, 2**40, 0], [2**33, 0, 0], [0, 0, 0]):
+            envs.step(torch.tensor(actions))  # may raise at a later step, once the report is ready
+        envs.close()
+
+
+def test_no_module_reaches_into_the_checks_private_helpers():
+    """The envs use `to_device`, `to_int`, `check_batch` and `Turns`; the helpers behind them stay private."""
+    package = Path(octax_gym.__file__).parent
+    users = sorted(path.relative_to(package).as_posix() for path in package.rglob("*.py")
+                   if "action_check._" in path.read_text())
+    assert users == []
