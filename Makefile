@@ -1,5 +1,5 @@
 # make demo   the games table, a random agent's steps/s on Pong, and a video of it (demo-pong.mp4)
-# make test   run the test suite (all but the tests marked slow: about 15 minutes on 2 cores)
+# make test   run the test suite (all but the tests marked slow: about 5 minutes on 2 cores), then name the 15 slowest
 # make test-slow  the slow tests: every archive game played, long ROM runs (CI runs both)
 # make bench  throughput of the core on Pong, against the octax package (benchmarks/README.md)
 # make bench-scaling  the scaling figure: octax-gym, octax, EnvPool and ale-py Pong against N (docs/scaling.md)
@@ -44,9 +44,10 @@ demo: $(VENV)/.installed-video
 	$(ROMS_READY)
 	$(PY) -m octax_gym.demo
 
+# The slowest tests are named at the end of every run, so that a regression of the suite's time is seen.
 test: $(VENV)/.installed-all
 	$(ROMS_READY)
-	$(PY) -m pytest $(PYTEST_ARGS) -m "not slow"
+	$(PY) -m pytest $(PYTEST_ARGS) -m "not slow" --durations=15
 
 test-slow: $(VENV)/.installed-all
 	$(ROMS_READY)

@@ -22,6 +22,17 @@ from shared_data import REQUIRE_SHARED, SHARED, TEST_SUITE_DIR, missing_shared, 
 # the user data folder that `octax-gym roms install` fills; `make test` sets this too.
 os.environ.setdefault("OCTAX_ROM_DIR", str(SHARED / "roms" / "octax"))
 
+# JAX's persistent compilation cache: most of this suite's time is XLA compiling the same programs
+# run after run, so a second run reads them from disk. The cache lives in the clone (.cache/, git
+# ignores it); the environment variables reach the CLI and example subprocesses the tests start.
+# A compiled program is keyed by its HLO, options and JAX version, so a stale entry is never used.
+_JAX_CACHE = os.environ.setdefault("JAX_COMPILATION_CACHE_DIR",
+                                   str(Path(__file__).resolve().parent.parent / ".cache" / "jax"))
+os.environ.setdefault("JAX_PERSISTENT_CACHE_MIN_COMPILE_TIME_SECS", "0.1")
+jax.config.update("jax_compilation_cache_dir", _JAX_CACHE)
+jax.config.update("jax_persistent_cache_min_compile_time_secs",
+                  float(os.environ["JAX_PERSISTENT_CACHE_MIN_COMPILE_TIME_SECS"]))
+
 
 def pytest_runtest_setup(item):
     """Tests marked `shared` need ../shared: skipped without it, failed if it is required."""
