@@ -13,6 +13,7 @@ only when the command runs.
 from __future__ import annotations
 
 import argparse
+import logging
 import os
 import sys
 from pathlib import Path
@@ -132,16 +133,28 @@ def _cmd_play(args: argparse.Namespace) -> int:
     return 0
 
 
+class _StderrHandler(logging.StreamHandler):
+    """Writes to whatever `sys.stderr` is when a line is logged, not when the handler was made: the
+    command can run more than once in a process (tests capture stderr anew each time), and a
+    handler holding the first run's stream would write to a closed file."""
+
+    @property
+    def stream(self):
+        return sys.stderr
+
+    @stream.setter
+    def stream(self, value):  # StreamHandler.__init__ assigns it; the property always answers sys.stderr
+        pass
+
+
 def _log_octax_gym() -> None:
     """The server's log lines (the `octax_gym` loggers, INFO and up) on stderr, and nobody else's:
     a root `logging.basicConfig(level=INFO)` would also print every library's INFO lines, JAX's
     "Unable to initialize backend 'tpu'" probe on each start among them."""
-    import logging
-
     logger = logging.getLogger("octax_gym")
     logger.setLevel(logging.INFO)
     if not any(getattr(handler, "octax_gym_play", False) for handler in logger.handlers):
-        handler = logging.StreamHandler(sys.stderr)
+        handler = _StderrHandler()
         handler.setFormatter(logging.Formatter("%(asctime)s %(name)s %(levelname)s %(message)s"))
         handler.octax_gym_play = True  # added once, however many times the command runs in a process
         logger.addHandler(handler)

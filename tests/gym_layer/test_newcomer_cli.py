@@ -106,6 +106,28 @@ def test_play_logs_its_own_lines_and_no_library_s_info(tmp_path):
     assert "tpu" not in result.stderr.lower(), result.stderr
 
 
+def test_play_logs_to_the_stderr_of_each_run(monkeypatch):
+    """The command run twice in one process (as tests and notebooks do): the second run's lines go
+    to the second run's stderr, not to the first one's, which may be closed by then."""
+    import logging
+
+    from octax_gym.cli.play import _log_octax_gym
+
+    logger = logging.getLogger("octax_gym")
+    monkeypatch.setattr(logger, "handlers", [])
+    first, second = io.StringIO(), io.StringIO()
+    monkeypatch.setattr(sys, "stderr", first)
+    _log_octax_gym()
+    logging.getLogger("octax_gym.play").info("first run")
+    first.close()
+    monkeypatch.setattr(sys, "stderr", second)
+    _log_octax_gym()
+    logging.getLogger("octax_gym.play").info("second run")
+    assert "octax_gym.play INFO second run" in second.getvalue()
+    assert "Logging error" not in second.getvalue()
+    assert len(logger.handlers) == 1
+
+
 def test_a_closed_pipe_ends_the_command_quietly(monkeypatch, capsys):
     read, write = os.pipe()
     os.close(read)  # the reader is gone before the first line, as `| head` is after ten
