@@ -24,8 +24,9 @@ seat, run by the same compiled step as every other env (`octax_gym.compiled_step
   so one policy can be trained or evaluated in either seat and still tell which side it plays.
 * reward: the learner's own (the change of its seat's score); terminated and truncated are the
   game's (one machine, one episode).
-* info: score (the learner's), lives, episode_step, current_player (the seat to move, -1 in a
-  simultaneous game) and `action_mask` (bool, (n,)): the actions open to the learner now. In a
+* info: score (the learner's), lives (the learner's: a game's count is player 1's, so seat 1 gets
+  -1, NO_LIVES), episode_step, current_player (the seat to move, -1 in a
+  simultaneous game) and `action_mask` (int8, (n,), as Gymnasium's `sample(mask=)` takes): the actions open to the learner now. In a
   turn-based game that is no-op alone while the opponent moves; any other action then, or one
   the game's `legal_fn` closes, raises `IllegalMoveError` (before the step for host actions,
   deferred for device ones, as out-of-range actions: `octax_gym.action_check`). `OctaxEnv`
@@ -126,11 +127,18 @@ def actions_of_both(env, view: View, step_keys: jax.Array, state, learner: jax.A
     return jnp.stack([learner, theirs] if view.seat == 0 else [theirs, learner], axis=1)
 
 
+# info["lives"] of a seat whose lives the game does not count (as the envs' info says without lives_fn).
+NO_LIVES = -1
+
+
 def learner_info(info: dict, seat: int) -> dict:
-    """The learner's part of a two-player info (batched or not): its score, the shared counts,
-    the seat to move, and its `action_mask`."""
+    """The learner's part of a two-player info (batched or not): its score, its lives, the shared
+    counts, the seat to move, and its `action_mask`. A game's `lives_fn` counts player 1's lives
+    (seat 0's), so seat 1 is told NO_LIVES rather than its opponent's count."""
     out = {name: value for name, value in info.items() if name not in ("score", "legal_action_mask")}
     out["score"] = info["score"][..., seat]
+    if seat != 0 and "lives" in info:
+        out["lives"] = jnp.full_like(info["lives"], NO_LIVES)
     out["action_mask"] = info["legal_action_mask"][..., seat, :]
     return out
 

@@ -67,9 +67,9 @@ from pettingzoo import AECEnv, ParallelEnv
 from octax_gym.action_check import to_int
 from octax_gym.choices import check_choice
 from octax_gym.multi_vector import MultiAgentVectorEnv
+from octax_gym.opponent import NO_LIVES  # the one definition, shared with the one-seat view
 
 FIXED_KEYWORDS = ("autoreset_mode", "backend")  # PettingZoo steps one episode of numpy arrays
-NO_LIVES = -1  # info["lives"] of a seat whose lives the game does not count (as the envs' info says)
 OFF_TURN = ("ignore", "raise")
 
 
