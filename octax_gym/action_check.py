@@ -16,11 +16,11 @@ mask (`info["legal_action_mask"]`) closes, a move by the seat whose turn it is n
 mover's `legal_fn` closes, raises `IllegalMoveError` (a ValueError): on the host before the step
 for host actions, from the step's device report for device ones (where it is played as no-op).
 
-Actions that arrive on the host (numpy arrays, lists, ints) are checked before the step, on the
-host: an out-of-range one raises at once and nothing runs. Actions that arrive as JAX arrays or
-torch tensors may still be being computed (JAX and CUDA run asynchronously), and reading them
-would make every step wait for the device: a sync per step, the cost a GPU pipeline exists to
-avoid. So their shape and dtype are checked from metadata, and their range inside the jitted step,
+Actions that arrive on the host (numpy arrays, lists, ints, torch tensors on the CPU, which torch
+computes synchronously) are checked before the step, on the host: an out-of-range one raises at
+once and nothing runs. Actions that arrive as JAX arrays or torch tensors on an accelerator may
+still be being computed (JAX and CUDA run asynchronously), and reading them would make every step
+wait for the device: a sync per step, the cost a GPU pipeline exists to avoid. So their shape and dtype are checked from metadata, and their range inside the jitted step,
 which keeps a report on the device: how many out-of-range actions arrived since the last check,
 and the first one (env, value). Those envs hold no key for that step.
 
@@ -97,8 +97,8 @@ def to_device(actions, num_envs: int, num_actions: int, device: jax.Device, game
 
     Everything is checked that can be without waiting for a device: the type, the integer
     dtype and the shape (num_envs,) always, from metadata; the values too when they are on the
-    host (numpy, lists), against `turns` as well. JAX arrays and torch tensors are never read
-    here: their range is checked inside the jitted step (`accumulate`, `DeferredCheck`), after a
+    host (numpy, lists, CPU tensors), against `turns` as well. JAX arrays and accelerator tensors
+    are never read here: their range is checked inside the jitted step (`accumulate`, `DeferredCheck`), after a
     narrowing that keeps an out-of-range value out of range (see the module docstring).
 
     Raises:
@@ -110,8 +110,11 @@ def to_device(actions, num_envs: int, num_actions: int, device: jax.Device, game
         if actions.dtype.is_floating_point or actions.dtype.is_complex or actions.dtype == torch.bool:
             raise TypeError(f"{game}: actions must be integers, got a torch tensor of {actions.dtype}")
         _check_shape(tuple(actions.shape), num_envs, game, agents)
-        narrowed, given = _torch_int32(actions.detach(), torch)
-        return DeviceActions(jax.device_put(jax.dlpack.from_dlpack(narrowed), device), True, given)
+        if _in_host_memory(actions):  # torch computes CPU tensors synchronously: reading one never waits
+            actions = actions.detach().numpy()  # checked below as numpy is, at once; copied by astype
+        else:
+            narrowed, given = _torch_int32(actions.detach(), torch)
+            return DeviceActions(jax.device_put(jax.dlpack.from_dlpack(narrowed), device), True, given)
     if isinstance(actions, jax.Array):
         _check_integer_dtype(actions.dtype, num_envs, num_actions, game, agents)
         _check_shape(actions.shape, num_envs, game, agents)
@@ -232,6 +235,12 @@ def _check_shape(shape: tuple, num_envs: int, who: str, agents: Optional[tuple[s
 def _out_of_range(value: int, num_actions: int, who: str, detail: str = "") -> InvalidActionError:
     """The one wording of an out-of-range action, host or device."""
     return InvalidActionError(f"{who}: action {value} is out of range; valid actions are 0..{num_actions - 1}{detail}")
+
+
+def _in_host_memory(tensor) -> bool:
+    """A torch tensor in the host's memory (on the CPU), whose values exist by the time torch
+    returns it; a CUDA tensor may still be being computed, and reading it would wait for the GPU."""
+    return tensor.device.type == "cpu"
 
 
 def _torch_if_tensor(value):

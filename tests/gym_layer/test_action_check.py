@@ -75,7 +75,9 @@ def test_jax_actions_are_never_read_on_the_step_path(make_envs, monkeypatch):
     assert list(np.asarray(reward)) == [8.0, 8.0, 8.0]
 
 
-def test_torch_actions_are_never_read_on_the_step_path(make_envs, monkeypatch):
+def test_accelerator_torch_actions_are_never_read_on_the_step_path(make_envs, monkeypatch):
+    """A tensor on an accelerator (a CUDA tensor, stood in for by one the check is told is not in
+    host memory: no GPU here) may still be being computed: its range is checked on the device."""
     torch = pytest.importorskip("torch", reason="the torch extra is installed by `make test`")
     envs = make_envs("torch")
     envs.reset(seed=0)
@@ -84,6 +86,7 @@ def test_torch_actions_are_never_read_on_the_step_path(make_envs, monkeypatch):
     def read(*args, **kwargs):
         raise AssertionError("the step path read a torch action on the host")
     with monkeypatch.context() as patch, jax.transfer_guard_device_to_host("disallow"):
+        patch.setattr("octax_gym.action_check._in_host_memory", lambda tensor: False)
         _no_waiting_reads(patch)
         for name in ("item", "tolist", "numpy", "__int__", "__index__", "__bool__", "__array__", "min", "max"):
             patch.setattr(torch.Tensor, name, read)
@@ -93,6 +96,19 @@ def test_torch_actions_are_never_read_on_the_step_path(make_envs, monkeypatch):
     jax.block_until_ready(envs.state)
     with pytest.raises(InvalidActionError, match=r"action 5 is out of range; valid actions are 0\.\.2 \(env 1"):
         envs.reset(options={"reset_mask": np.ones(3, bool)})
+
+
+@pytest.mark.parametrize("backend", ["torch", "jax"])
+def test_a_cpu_torch_action_is_refused_by_the_step_that_gets_it(make_envs, backend):
+    """A CPU tensor's values exist when torch returns it: checked at once on the host, as numpy is,
+    so int64 2**32 + 1 (once wrapped to int32 and played as action 1) is refused before anything runs."""
+    torch = pytest.importorskip("torch", reason="the torch extra is installed by `make test`")
+    envs = make_envs(backend)
+    envs.reset(seed=0)
+    for value in (2**32 + 1, 5):
+        with pytest.raises(InvalidActionError, match=rf"action {value} is out of range; valid actions are 0\.\.2"):
+            envs.step(torch.tensor([0, value, 1], dtype=torch.int64))
+    assert np.asarray(envs.step(torch.tensor([2, 1, 0]))[1]).tolist() == [8.0, 4.0, 0.0]
 
 
 def test_numpy_backend_reports_a_bad_device_action_from_the_same_step(make_envs):
@@ -332,9 +348,11 @@ def test_unsigned_device_actions_are_named_by_their_value(make_envs, dtype):
         envs.close()
 
 
-def test_the_first_bad_step_s_value_is_named_after_clean_ones(make_envs):
-    """Several steps pending: the error names the first bad action as given, not a later one's."""
+def test_the_first_bad_step_s_value_is_named_after_clean_ones(make_envs, monkeypatch):
+    """Several steps pending: the error names the first bad action as given, not a later one's
+    (accelerator tensors, stood in for as above, are checked on the device)."""
     torch = pytest.importorskip("torch", reason="the torch extra is installed by `make test`")
+    monkeypatch.setattr("octax_gym.action_check._in_host_memory", lambda tensor: False)
     envs = make_envs("jax")
     envs.reset(seed=0)
     message = rf"action {2**40} is out of range; valid actions are 0\.\.2 \(env 1, "
