@@ -1,8 +1,8 @@
 """Games group 1 through the env API: Pong, Brix, Tetris, Blinky, Worm, Squash, VerticalBrix,
 WipeOff and Filter.
 
-Each game is compiled once (a jitted batched reset and a jitted scan of `CHUNK` batched steps,
-cached per game id) and run twice, 16 envs each, with autoreset:
+All nine games run in one compiled program (a mix: tests/core_games/game_harness.py), twice,
+16 envs per game, with autoreset:
 
 * a scripted rollout: the first envs follow the game's `Plan` (a held action, a cycle of
   actions, a closed-loop policy written against the game's registers, or a replayed action
@@ -19,15 +19,9 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 import pytest
-from game_harness import (
-    CHUNK,
-    Harness,
-    N,
-    Plan,
-    Rollout,
-    assert_episode_adds_up,
-    reset_keys,
-)
+from game_harness import CHUNK, Harness, N, Plan, Rollout, assert_episode_adds_up
+
+from octax_core.env.games import get_spec
 
 GAMES = ("Pong", "Brix", "Tetris", "Blinky", "Worm", "Squash", "VerticalBrix", "WipeOff", "Filter")
 
@@ -77,8 +71,8 @@ PLANS = {
 
 
 HARNESS = Harness(PLANS, autoreset=True)
-_compiled, _scripted, _random, _reset = HARNESS.compiled, HARNESS.scripted, HARNESS.random, HARNESS.reset_env0
-_reset_keys, _assert_episode_adds_up = reset_keys, assert_episode_adds_up
+_scripted, _random, _reset = HARNESS.scripted, HARNESS.random, HARNESS.reset_env0
+_assert_episode_adds_up = assert_episode_adds_up
 
 
 @pytest.fixture(scope="module")
@@ -87,15 +81,18 @@ def rom_dir(octax_rom_dir) -> str:
 
 
 def _run_with_register(game_id: str, rom_dir: str, register: int, value: int, action) -> Rollout:
-    """One chunk from reset with V[register] = value in every env, `action` (an int, or a tuple
-    cycled) in all of them; the episode's score starts from the changed state."""
-    env, params, reset, run = _compiled(game_id, rom_dir)
-    _, state = reset(_reset_keys(), params)
-    machine = state.machine.replace(V=state.machine.V.at[:, register].set(value))
-    state = state.replace(machine=machine, score=jax.vmap(env.spec.score_fn)(machine).astype(jnp.float32))
-    actions = np.repeat(np.resize(np.array(action, np.int32), CHUNK)[:, None], N, axis=1)
-    _, out = run(state, jnp.asarray(actions), jnp.zeros(N, bool), jax.random.key(0))
-    return Rollout(*jax.tree.map(np.asarray, out))
+    """One chunk from reset with V[register] = value in the game's envs, `action` (an int, or a
+    tuple cycled) in all of them; the episode's score starts from the changed state."""
+    _, params, reset, _ = HARNESS.compiled(rom_dir)
+    _, state = reset(params)
+    envs = HARNESS.envs(game_id)
+    machine = state.machine.replace(V=state.machine.V.at[envs, register].set(value))
+    score = jax.vmap(get_spec(game_id).score_fn)(machine).astype(jnp.float32)
+    own = jnp.zeros(len(GAMES) * N, bool).at[envs].set(True)
+    state = state.replace(machine=machine, score=jnp.where(own, score, state.score))
+    actions = np.zeros((CHUNK, len(GAMES) * N), np.int32)
+    actions[:, envs] = np.resize(np.array(action, np.int32), CHUNK)[:, None]
+    return HARNESS.cut(HARNESS.run_chunk(rom_dir, state, actions), game_id, CHUNK)
 
 
 # ---- (1) the start-up reaches gameplay, and the game answers its keys ------------------------

@@ -1,9 +1,9 @@
 """Games group 2 through the env API: Missile, Rocket, Submarine, Tank, UFO, Airplane, Deep8,
 ShootingStars, FlightRunner and Spacejam.
 
-Each game is compiled once (a jitted batched reset and a jitted scan of `CHUNK` batched steps,
-cached per game id) and run twice, 16 envs each, without autoreset (an ended env stands still, so
-its terminal registers stay readable):
+All ten games run in one compiled program (a mix: tests/core_games/game_harness.py), twice, 16
+envs per game, without autoreset (an ended env stands still, so its terminal registers stay
+readable):
 
 * a scripted rollout: the first envs follow the game's `Plan` (a held action, or a closed-loop
   policy written against the game's registers and RAM), the rest take no-ops;
