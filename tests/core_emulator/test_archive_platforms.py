@@ -5,6 +5,14 @@ entry gives (Octo's option flags: `octax_core.emulator.quirks.quirks_from_octo`)
 The keys follow a fixed schedule (held for 8 frames, then 8 frames free, each hold a new key) so
 that menus are left and games move. The whole snapshot (RAM, registers, both planes, flags, mode,
 plane selection, audio) must match after every frame.
+
+Each program's machine config (platform, quirks, tick rate) is its own compiled program (programs
+of one config share it), so `make test` runs a representative subset, `FAST`: every (platform,
+quirks) profile of the archive (a test below checks that), both frame loops (under 25 instructions
+a frame, and idle skipping from 25), and what the programs do in their first 120 frames on the
+reference: hires and the mode switches, 16x16 sprites in both modes, scrolling on both platforms,
+XO-CHIP's plane 2 and both planes, long I beyond 4 KiB, register ranges, audio patterns, big
+digits, flag registers, BCD, BNNN, CXNN and FX0A. `make test-slow` runs all 53.
 """
 
 from __future__ import annotations
@@ -16,6 +24,7 @@ import pytest
 from reference import RefMachine, first_difference
 
 import octax_core
+from octax_core.emulator.idle import SKIP_FROM
 from octax_core.emulator.quirks import quirks_from_octo
 from octax_core.env.romstore import ARCHIVE_ROM_DIR as ARCHIVE  # the archive ships in the package
 
@@ -30,6 +39,20 @@ def archive_programs() -> dict:
 
 PROGRAMS = archive_programs()
 
+# name: what it adds (in its first 120 frames on tests/reference.py)
+FAST = {
+    "DVN8": "schip, Octo's default quirks, 20 ipf (the plain frame loop): big digits, 16x16 hires sprites",
+    "chipcross": "the same compiled program: flag registers, BCD, FX0A",
+    "dodge": "schip, Octo's defaults, 1000 ipf: scrolling down in lores, CXNN, FX0A",
+    "sens8tion": "schip, its own quirks (no increment, shift and jump by VX): hires and lores switches, lores 16x16",
+    "octogon": "schip, the SUPER-CHIP profile, 200 ipf: lores 16x16 sprites",
+    "binding": "schip, Octo's defaults with clipping, 1000 ipf: 16x16 hires sprites, BCD, CXNN",
+    "flutterby": "xochip, Octo's defaults, 7 ipf (the plain frame loop): plane 2 in hires, audio pattern, CXNN",
+    "t8nks": "xochip, Octo's defaults, 1000 ipf: both planes, long I past 4 KiB, ranges, flags, BCD, BNNN, FX0A",
+    "skyward": "xochip, Octo's defaults without increment: scrolling down, both planes, audio, ranges, long I",
+    "superneatboy": "xochip, Octo's defaults with clipping: both planes, long I, ranges, audio",
+}
+
 
 def keys_at(frame: int) -> int:
     hold = frame // 8
@@ -41,7 +64,19 @@ def test_the_archive_has_its_53_modern_programs():
     assert sorted({entry["platform"] for entry in PROGRAMS.values()}) == ["schip", "xochip"]
 
 
-@pytest.mark.parametrize("name", PROGRAMS)
+def profile(entry) -> tuple:
+    return entry["platform"], quirks_from_octo(entry["options"])
+
+
+def test_the_fast_subset_has_every_platform_and_quirk_profile_of_the_archive():
+    assert set(FAST) <= set(PROGRAMS)
+    assert {profile(PROGRAMS[name]) for name in FAST} == {profile(entry) for entry in PROGRAMS.values()}
+    rates = {int(PROGRAMS[name]["options"].get("tickrate", 20)) for name in FAST}
+    assert min(rates) < SKIP_FROM <= max(rates)  # both frame loops: plain, and idle skipping
+
+
+@pytest.mark.parametrize("name", [name if name in FAST else pytest.param(name, marks=pytest.mark.slow)
+                                  for name in PROGRAMS])
 def test_program_matches_reference_frame_by_frame(name, jit_run_frames):
     entry = PROGRAMS[name]
     rom = (ARCHIVE / f"{name}.ch8").read_bytes()
