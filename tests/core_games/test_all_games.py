@@ -3,6 +3,7 @@ each passes the env contract suite, and each level family member survives random
 per-group files and test_own_games.py cover the rest). The archive suite: test_archive_suite.py."""
 
 import jax
+import jax.numpy as jnp
 import numpy as np
 import pytest
 
@@ -54,10 +55,13 @@ def test_specs_are_complete():
         assert spec.quirks in ("chip8", "schip"), f"{game_id}: quirks {spec.quirks!r}"
 
 
-# make test runs the contract on one game of each ROM family and our games' middle levels; every
-# other id (levels of the same ROM, the rest of the suite) in make test-slow (6-10 s of compiles each).
-CONTRACT_IN_MAKE_TEST = {"Airplane", "Brix", "Cavern1", "Pong", "SpaceFlight1", "TargetShooter1", "Tetris", "Blinky",
-                         "Cycles", "Dodge", "Duel", "Flak"}
+# make test runs the contract on four games: an octax game with the VIP's quirks (Pong), one with
+# SUPER-CHIP's (Blinky), one of ours (Dodge) and a two-player game played solo (Duel). The
+# contract's checks (shapes, dtypes, determinism, batch independence, one trace, refused actions)
+# are the Env's; what a game brings to them (its score, lives and end, its keys) every other id
+# gets in make test-slow (6-10 s of compiles each), and in make test from the per-game files
+# (test_games_group*.py, test_games_levels.py, test_own_games.py: random play, finite rewards).
+CONTRACT_IN_MAKE_TEST = {"Pong", "Blinky", "Dodge", "Duel"}
 
 
 @pytest.mark.parametrize("game_id", [g if g in CONTRACT_IN_MAKE_TEST else pytest.param(g, marks=pytest.mark.slow)
@@ -66,21 +70,37 @@ def test_contract(game_id, octax_rom_dir):
     check_env(game_id, num_envs=2, steps=3)
 
 
-@pytest.mark.parametrize("game_id", [g if g in ("Cavern2", "SpaceFlight2", "TargetShooter2")
-                                     else pytest.param(g, marks=pytest.mark.slow) for g in OTHER_LEVELS])
-def test_random_policy_gives_finite_rewards(game_id, octax_rom_dir):
-    env, params = octax_core.make(game_id)
+# test_games_levels.py plays level 1 of each family at random through the env; here level 2 of
+# each in make test, every other level in make test-slow: 16 envs x 1,500 uniform random steps per
+# level, all the levels of a run in one compiled mix (each env plays exactly what make(level)
+# plays: tests/core_env/test_mix.py).
+FAST_LEVELS = ["Cavern2", "SpaceFlight2", "TargetShooter2"]
+
+
+@pytest.mark.parametrize("levels", [FAST_LEVELS, pytest.param([g for g in OTHER_LEVELS if g not in FAST_LEVELS],
+                                                              marks=pytest.mark.slow)],
+                         ids=["level2", "other-levels"])
+def test_random_policy_gives_finite_rewards(levels, octax_rom_dir):
+    env, params = octax_core.make_mix(levels)
     num_envs, steps = 16, 1500
-    reset = jax.jit(jax.vmap(env.reset, in_axes=(0, None)))
-    step = jax.jit(jax.vmap(env.step, in_axes=(0, 0, 0, None)))
-    _, state = reset(jax.random.split(jax.random.key(0), num_envs), params)
-    actions = np.random.default_rng(0).integers(0, env.num_actions, (steps, num_envs), dtype=np.int32)
-    keys = jax.random.split(jax.random.key(1), (steps, num_envs))
-    total = np.zeros(num_envs)
-    for t in range(steps):
-        _, state, reward, _, _, _ = step(keys[t], state, actions[t], params)
-        total += np.asarray(reward)
-    assert np.all(np.isfinite(total)), f"{game_id}: returns {total}"
+    games = np.repeat(np.arange(len(levels)), num_envs)
+    keys = jax.random.split(jax.random.key(0), num_envs)[np.tile(np.arange(num_envs), len(levels))]
+    actions = np.concatenate([np.random.default_rng(0).integers(0, len(octax_core.get_spec(g).action_keys) + 1,
+                                                                (steps, num_envs), dtype=np.int32) for g in levels], 1)
+    step_keys = jax.random.split(jax.random.key(1), (steps, num_envs))[:, np.tile(np.arange(num_envs), len(levels))]
+    step = jax.vmap(env.step, in_axes=(0, 0, 0, None))
+
+    @jax.jit
+    def returns(keys, games, actions, step_keys):
+        _, state = jax.vmap(lambda k, g: env.reset(k, params, game=g))(keys, games)
+        def body(state, xs):
+            _, state, reward, *_ = step(xs[1], state, xs[0], params)
+            return state, reward
+        return jax.lax.scan(body, state, (actions, step_keys))[1].sum(0)
+
+    total = np.asarray(returns(keys, jnp.asarray(games), jnp.asarray(actions), step_keys))
+    for g, game_id in enumerate(levels):
+        assert np.all(np.isfinite(total[games == g])), f"{game_id}: returns {total[games == g]}"
 
 
 def test_docs_games_table_is_current():
