@@ -3,7 +3,9 @@
 Each seat's keys move its own side only; each seat's reward is its own score's change, and the
 two sum to zero; the scripted policies (`Seats.scripted_policy`) beat uniform random play from
 either seat; episodes end. Cycles' two halves mirror each other exactly: the mirrored actions
-give the mirrored game. One jitted rollout per game (its policies are an argument), 16 envs.
+give the mirrored game. One jitted rollout per game (each env's per-step plan of both seats, an
+action, RANDOM or SCRIPTED, is an argument), 16 envs; Cycles2 (a speed between Cycles1's and
+Cycles3's) in make test-slow.
 That the committed ROMs are what the sources build is tests/core_tools/test_own_roms.py's (it
 globs roms/*.8o).
 """
@@ -21,8 +23,11 @@ import octax_core
 from octax_core.env.games import cycles, duel
 
 GAMES = ["Duel", "Cycles1", "Cycles2", "Cycles3"]
+# Cycles' levels differ in speed only: make test plays the slowest and the fastest, test-slow all.
+FAST = ["Duel", "Cycles1", "Cycles3"]
+GAME_PARAMS = [g if g in FAST else pytest.param(g, marks=pytest.mark.slow) for g in GAMES]
 NUM_ENVS = 16
-RANDOM, SCRIPTED, NOOP = 0, 1, 2
+RANDOM, SCRIPTED, NOOP = -1, -2, 0  # plan entries; NOOP (0) and up: hold that action
 
 
 @functools.cache
@@ -32,22 +37,24 @@ def _env(game_id: str):
 
 @functools.cache
 def _rollout(game_id: str, steps: int):
-    """(key, modes (2,)) -> per-step rewards (T, N, 2), done (T, N), V (T, N, 16), for NUM_ENVS
-    envs; a seat's mode is RANDOM, SCRIPTED or NOOP. Episodes are not reset once done."""
+    """(seed, plan (steps, NUM_ENVS, 2)) -> per-step rewards (T, N, 2), done (T, N), V (T, N, 16),
+    for NUM_ENVS envs; a plan entry is RANDOM, SCRIPTED or an action (NOOP = 0). Episodes are not
+    reset once done. One compile per game: the tests that drive seats by hand use it too."""
     env, params = _env(game_id)
     policy = env.seats.scripted_policy
 
-    def one(key, modes):
+    def one(key, plan):
         reset_key, run_key = jax.random.split(key)
         _, state = env.reset(reset_key, params)
 
-        def body(carry, key):
+        def body(carry, inputs):
             state, done = carry
+            key, wanted = inputs
             pick, step_key = jax.random.split(key)
             random_actions = jax.random.randint(pick, (2,), 0, env.num_actions)
             actions = jnp.stack([
-                jnp.select([modes[seat] == SCRIPTED, modes[seat] == RANDOM],
-                           [policy(state.machine, seat), random_actions[seat]], 0)
+                jnp.select([wanted[seat] == SCRIPTED, wanted[seat] == RANDOM],
+                           [policy(state.machine, seat), random_actions[seat]], wanted[seat])
                 for seat in range(2)]).astype(jnp.int32)
             _, new_state, rewards, terminated, truncated, _ = env.step_env(step_key, state, actions, params)
             new_state = jax.tree.map(lambda new, old: jnp.where(done, old, new), new_state, state)
@@ -55,19 +62,29 @@ def _rollout(game_id: str, steps: int):
             done = done | terminated | truncated
             return (new_state, done), (rewards, done, new_state.machine.V)
 
-        return jax.lax.scan(body, (state, jnp.bool_(False)), jax.random.split(run_key, steps))[1]
+        return jax.lax.scan(body, (state, jnp.bool_(False)), (jax.random.split(run_key, steps), plan))[1]
 
-    run = jax.jit(jax.vmap(one, in_axes=(0, None)))
-    return lambda seed, modes: tuple(np.asarray(x).swapaxes(0, 1) for x in run(
-        jax.random.split(jax.random.key(seed), NUM_ENVS), jnp.asarray(modes)))
+    run = jax.jit(jax.vmap(one, in_axes=(0, 1)))
+
+    def rollout(seed, plan):
+        """`seed`: an int (env i resets from its own key) or one key, which every env resets from."""
+        keys = jax.random.split(jax.random.key(seed), NUM_ENVS) if isinstance(seed, int) else \
+            jnp.stack([seed] * NUM_ENVS)
+        return tuple(np.asarray(x).swapaxes(0, 1) for x in run(keys, jnp.asarray(plan, jnp.int32)))
+    return rollout
 
 
 STEPS = {"Duel": 900, "Cycles1": 600, "Cycles2": 600, "Cycles3": 600}
 
 
+def _hold(game_id: str, modes) -> np.ndarray:
+    """The plan that holds `modes` (one entry per seat) in every env at every step."""
+    return np.broadcast_to(np.array(modes), (STEPS[game_id], NUM_ENVS, 2))
+
+
 @functools.cache
 def _play(game_id: str, modes: tuple[int, int], seed: int = 0):
-    return _rollout(game_id, STEPS[game_id])(seed, modes)
+    return _rollout(game_id, STEPS[game_id])(seed, _hold(game_id, modes))
 
 
 def test_the_two_player_games_are_listed_and_solo():
@@ -96,19 +113,27 @@ def test_solo_env_is_player_1_against_an_idle_player_2(game_id):
 # --- each seat's keys move its own side ---------------------------------------------------------
 
 
+# Each seat's keys, tried from one start: env j of one rollout holds VARIANTS[game][j] (one
+# action per seat) after WARMUP[game] no-op steps, for KEY_STEPS steps.
+VARIANTS = {"Duel": [(0, 0), (1, 0), (0, 2)],
+            "Cycles1": [(0, 0), (1, 0), (0, 1), (2, 0), (0, 2), (3, 4)]}
+WARMUP = {"Duel": 6, "Cycles1": 20}
+KEY_STEPS = {"Duel": 4, "Cycles1": 3}
+
+
 @functools.cache
-def _step(game_id: str):
-    return jax.jit(_env(game_id)[0].step_env)
+def _variants(game_id: str):
+    warmup, steps = WARMUP[game_id], KEY_STEPS[game_id]
+    plan = np.zeros((STEPS[game_id], NUM_ENVS, 2), np.int32)
+    plan[warmup:warmup + steps, :len(VARIANTS[game_id])] = VARIANTS[game_id]
+    V = _rollout(game_id, STEPS[game_id])(jax.random.key(3), plan)[2]
+    return V[warmup + steps - 1].astype(int)
 
 
 def _after(game_id: str, actions, warmup: int, steps: int):
-    env, params = _env(game_id)
-    step = _step(game_id)
-    _, state = env.reset(jax.random.key(3), params)
-    for t in range(warmup + steps):
-        act = jnp.array(actions if t >= warmup else (0, 0), jnp.int32)
-        _, state, *_ = step(jax.random.key(t), state, act, params)
-    return np.asarray(state.machine.V).astype(int)
+    """The registers after `warmup` no-op steps, then `steps` steps of `actions` (one per seat)."""
+    assert (warmup, steps) == (WARMUP[game_id], KEY_STEPS[game_id])
+    return _variants(game_id)[VARIANTS[game_id].index(tuple(actions))]
 
 
 def test_duel_keys_move_their_own_paddle_only():
@@ -137,7 +162,7 @@ def test_cycles_ignores_the_way_back():
 # --- rewards --------------------------------------------------------------------------------------
 
 
-@pytest.mark.parametrize("game_id", GAMES)
+@pytest.mark.parametrize("game_id", GAME_PARAMS)
 @pytest.mark.parametrize("modes", [(SCRIPTED, RANDOM), (RANDOM, SCRIPTED)])
 def test_rewards_are_each_seats_own_points_and_zero_sum(game_id, modes):
     rewards, done, V = _play(game_id, modes)
@@ -152,7 +177,7 @@ def test_rewards_are_each_seats_own_points_and_zero_sum(game_id, modes):
 # --- the scripted policy beats random; episodes end -----------------------------------------------
 
 
-@pytest.mark.parametrize("game_id", GAMES)
+@pytest.mark.parametrize("game_id", GAME_PARAMS)
 def test_scripted_policy_beats_random_from_either_seat(game_id):
     for seat, modes in ((0, (SCRIPTED, RANDOM)), (1, (RANDOM, SCRIPTED))):
         rewards, done, V = _play(game_id, modes)
@@ -161,7 +186,7 @@ def test_scripted_policy_beats_random_from_either_seat(game_id):
         assert (returns[done[-1]] == (duel.WIN if game_id == "Duel" else cycles.WIN)).mean() >= 0.9
 
 
-@pytest.mark.parametrize("game_id", GAMES)
+@pytest.mark.parametrize("game_id", GAME_PARAMS)
 def test_random_play_is_even_and_episodes_end(game_id):
     rewards, done, V = _play(game_id, (RANDOM, RANDOM))
     assert done[-1].mean() >= 0.8, f"{game_id}: {done[-1].mean():.2f} of the random episodes ended"
@@ -182,26 +207,23 @@ def test_cycles_mirrored_actions_give_the_mirrored_game():
     match, mirrored: every round has the other winner, and where the cycles crashed mirrors too.
     (Within a move the ROM updates player 1 a few instructions before player 2, so a step may end
     between the two: the comparison is per round, not per step.)"""
-    env, params = _env("Cycles3")
-    step = jax.jit(jax.vmap(env.step_env, in_axes=(0, 0, 0, None)))
-    keys = jax.random.split(jax.random.key(5), NUM_ENVS)
-    _, state = jax.vmap(env.reset, in_axes=(0, None))(keys, params)
-    mirrored = state
+    env, _ = _env("Cycles3")
     actions = np.random.default_rng(0).integers(0, env.num_actions, (300, NUM_ENVS, 2))
+    plan = np.zeros((STEPS["Cycles3"], NUM_ENVS, 2), np.int32)
+    run = _rollout("Cycles3", STEPS["Cycles3"])  # both from the same starts, with the same step keys
+    rewards, _, V = (x[:300] for x in run(5, np.concatenate([actions, plan[300:]])))
+    other, _, W = (x[:300] for x in run(5, np.concatenate([_MIRROR[actions[..., ::-1]], plan[300:]])))
     heading = np.array([cycles.UP, cycles.RIGHT, cycles.LEFT, cycles.DOWN])  # left <-> right
+    V, W = V.astype(int), W.astype(int)
     events, other_events = [[] for _ in range(NUM_ENVS)], [[] for _ in range(NUM_ENVS)]
-    for t, act in enumerate(actions):
-        step_keys = jax.random.split(jax.random.key(t), NUM_ENVS)
-        _, state, rewards, *_ = step(step_keys, state, jnp.asarray(act, jnp.int32), params)
-        _, mirrored, other, *_ = step(step_keys, mirrored, jnp.asarray(_MIRROR[act[:, ::-1]], jnp.int32), params)
-        V, W = np.asarray(state.machine.V).astype(int), np.asarray(mirrored.machine.V).astype(int)
-        for i in np.flatnonzero(np.asarray(rewards)[:, 0]):
-            events[i].append((float(rewards[i, 0]), V[i, cycles.X1], V[i, cycles.X2], V[i, cycles.Y1],
-                              V[i, cycles.Y2], V[i, cycles.DIR1], V[i, cycles.DIR2]))
-        for i in np.flatnonzero(np.asarray(other)[:, 0]):
-            other_events[i].append((-float(other[i, 0]), 31 - W[i, cycles.X2], 31 - W[i, cycles.X1],
-                                    W[i, cycles.Y2], W[i, cycles.Y1], heading[W[i, cycles.DIR2]],
-                                    heading[W[i, cycles.DIR1]]))
+    for t in range(300):
+        for i in np.flatnonzero(rewards[t, :, 0]):
+            events[i].append((float(rewards[t, i, 0]), V[t, i, cycles.X1], V[t, i, cycles.X2], V[t, i, cycles.Y1],
+                              V[t, i, cycles.Y2], V[t, i, cycles.DIR1], V[t, i, cycles.DIR2]))
+        for i in np.flatnonzero(other[t, :, 0]):
+            other_events[i].append((-float(other[t, i, 0]), 31 - W[t, i, cycles.X2], 31 - W[t, i, cycles.X1],
+                                    W[t, i, cycles.Y2], W[t, i, cycles.Y1], heading[W[t, i, cycles.DIR2]],
+                                    heading[W[t, i, cycles.DIR1]]))
     for i in range(NUM_ENVS):  # a round ending on the last step may be scored a step apart
         shared = min(len(events[i]), len(other_events[i]))
         assert abs(len(events[i]) - len(other_events[i])) <= 1 and events[i][:shared] == other_events[i][:shared], i
