@@ -11,7 +11,7 @@ instead of two programs per game. Env `g * N + i` of the batch plays game `g`, r
 from the key `make(game)`'s env `i` was reset with, so it plays exactly what `make(game)` plays
 from the same keys and actions (the mix's exactness: tests/core_env/test_mix.py, and every game
 in test_mix_every_game.py, slow). With autoreset, an ended episode restarts on the env's own game
-(`_PinnedMix`: the mix would draw one from its weights); every rollout checks that no env ever
+(`PinnedMix`: the mix would draw one from its weights); every rollout checks that no env ever
 changed game. Each module's batch is run twice, `N` envs per game:
 
 * `scripted`: the first envs of each game follow the game's `Plan`, the rest take no-ops (the
@@ -103,7 +103,7 @@ def assert_episode_adds_up(rollout: Rollout, i: int, end: int, start_score: floa
     assert rollout.reward[:end + 1, i].sum() == pytest.approx(rollout.score[end, i] - start_score)
 
 
-class _PinnedMix(MixEnv):
+class PinnedMix(MixEnv):
     """A mix whose autoreset restarts an env on its own game: `Env._restart_where` with the reset
     given the ended episode's game, which draws the start as `make(game)`'s autoreset does."""
 
@@ -137,7 +137,7 @@ class Harness:
         """The mix and its jitted batched reset and chunk runner, one compile each for all games:
         (env, params, reset(params) -> (obs, state), run(state, actions, use_policy, key))."""
         specs = [get_spec(game) for game in self.games]
-        env = _PinnedMix(specs, None, dict(autoreset=self.autoreset), [rom_dir] * len(specs))
+        env = PinnedMix(specs, None, dict(autoreset=self.autoreset), [rom_dir] * len(specs))
         params = env.default_params
         games = jnp.repeat(jnp.arange(len(self.games), dtype=jnp.int32), N)
         each = jnp.tile(jnp.arange(N), len(self.games))  # env g * N + i: the game's env i
