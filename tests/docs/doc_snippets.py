@@ -13,7 +13,12 @@ Two comments on a block's first line change how it is used:
 * `# file: <path>` (the whole line): the page asks the reader to save the block as that file,
   which later blocks import; it is written there, not run.
 
-This file is also the subprocess's program: `python doc_snippets.py BLOCKS.json` runs blocks.
+This file is also the subprocess's program. `python doc_snippets.py --serve` is a page server: it
+imports what most pages import (jax, numpy, gymnasium, octax_core, octax_gym, torch: ~1-3 s of CPU
+per interpreter) once, without starting any JAX backend, then forks one child per page. Each child
+is a fresh reader's session as far as a page can tell: its own process, cwd, environment, stdout
+and stderr, started from the same just-imported state (nothing a page does reaches the next one),
+and ended by a normal interpreter exit. Only the import seconds are shared.
 """
 
 from __future__ import annotations
@@ -21,7 +26,7 @@ from __future__ import annotations
 import json
 import os
 import re
-import resource
+import signal
 import subprocess
 import sys
 import time
@@ -131,21 +136,65 @@ class PageRun:
     stdout: str
     stderr: str
     seconds: float      # wall clock
-    cpu_seconds: float  # the subprocess's user + system time: what the page costs a loaded machine
+    cpu_seconds: float  # the page process's user + system time: what the page costs a loaded machine
 
 
-def run_page(page: Path, scratch: Path, timeout: float = 300.0) -> PageRun:
-    """Run `page`'s Python blocks in order in one fresh interpreter whose cwd is `scratch`
+# What the page server imports before it forks: the modules most pages import (torch for the sb3
+# and torchrl pages). None of them starts a JAX backend or a thread (the server checks), so a
+# fork is safe; a module a page needs beyond these it imports itself, as a reader would.
+PRELOAD = ("numpy", "jax", "jax.numpy", "gymnasium", "octax_core", "octax_gym", "torch")
+
+
+class PageServer:
+    """The pytest side of `python doc_snippets.py --serve`: one server per test module, one forked
+    child per page (see the module docstring). `close()` ends it."""
+
+    def __init__(self, folder: Path):
+        folder.mkdir(parents=True, exist_ok=True)
+        self._log = folder / "server-stderr.txt"
+        with open(self._log, "w") as log:
+            self._process = subprocess.Popen(
+                [sys.executable, str(Path(__file__).resolve()), "--serve"], cwd=folder,
+                env=snippet_env(folder), stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=log, text=True)
+        if self._read() != {"ready": True}:
+            raise RuntimeError("the page server did not start")
+
+    def _read(self) -> dict:
+        line = self._process.stdout.readline()
+        if not line:
+            self._process.wait()
+            raise RuntimeError(f"the page server ended (return code {self._process.returncode}):\n"
+                               f"{self._log.read_text()[-6000:]}")
+        return json.loads(line)
+
+    def run(self, plan: Path, cwd: Path, env: dict, timeout: float) -> dict:
+        self._process.stdin.write(json.dumps({"plan": str(plan), "cwd": str(cwd), "env": env, "timeout": timeout}) + "\n")
+        self._process.stdin.flush()
+        return self._read()
+
+    def close(self) -> None:
+        if self._process.poll() is None:
+            self._process.stdin.close()
+            try:
+                self._process.wait(timeout=30)
+            except subprocess.TimeoutExpired:
+                self._process.kill()
+                self._process.wait()
+
+
+def run_page(page: Path, scratch: Path, server: PageServer, timeout: float = 300.0) -> PageRun:
+    """Run `page`'s Python blocks in order in one fresh process of `server` whose cwd is `scratch`
     (already a `scratch_clone`). A non-zero return code means a block failed; stderr says which."""
     blocks = python_blocks(page)
     plan = scratch / ".snippet-blocks.json"
     plan.write_text(json.dumps([asdict(block) for block in blocks]), encoding="utf-8")
-    start, before = time.perf_counter(), resource.getrusage(resource.RUSAGE_CHILDREN)
-    result = subprocess.run([sys.executable, str(Path(__file__).resolve()), str(plan)], cwd=scratch,
-                            env=snippet_env(scratch), capture_output=True, text=True, timeout=timeout, check=False)
-    after = resource.getrusage(resource.RUSAGE_CHILDREN)
-    cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
-    return PageRun(result.returncode, result.stdout, result.stderr, time.perf_counter() - start, cpu)
+    start = time.perf_counter()
+    reply = server.run(plan, scratch, snippet_env(scratch), timeout)
+    seconds = time.perf_counter() - start
+    stdout, stderr = (Path(reply[name]).read_text(encoding="utf-8", errors="replace") for name in ("stdout", "stderr"))
+    if reply["timed_out"]:
+        stderr += f"\n{page.name}: the page did not finish in {timeout:.0f} s and was killed\n"
+    return PageRun(reply["returncode"], stdout, stderr, seconds, reply["cpu_seconds"])
 
 
 def _numbered(text: str, first: int) -> str:
@@ -185,5 +234,80 @@ def _run_blocks(plan: Path) -> int:
     return 0
 
 
+def _exit_as_python_would(code: int) -> None:
+    """End a page's process as an interpreter ends, less the module teardown: the page's objects
+    collected (their finalizers run), non-daemon threads joined, atexit handlers run, output
+    flushed. Tearing down every module of the preload (torch, jax) would touch, and so copy, all of
+    the server's memory: ~0.75 s of CPU a page for nothing a page can see."""
+    import atexit
+    import gc
+    import threading
+
+    gc.collect()
+    threading._shutdown()  # noqa: SLF001 - what Py_FinalizeEx calls first
+    atexit._run_exitfuncs()  # noqa: SLF001
+    sys.stdout.flush()
+    sys.stderr.flush()
+    os._exit(code)
+
+
+def _serve() -> int:
+    """The page server: preload, then for each request line (a plan, a cwd, an environment and a
+    timeout) fork a child that runs the plan as `python doc_snippets.py PLAN` would, and answer
+    with its return code, CPU time and where its stdout and stderr are."""
+    import importlib
+
+    for name in PRELOAD:
+        importlib.import_module(name)
+    from jax._src import xla_bridge
+
+    # A fork is only safe from a single-threaded process: JAX's backends start threads (and JAX
+    # warns at a fork once they have), so the preload must not have started one.
+    if xla_bridge.backends_are_initialized() or len(os.listdir("/proc/self/task")) != 1:
+        print(f"the preload started a JAX backend or a thread; cannot fork pages safely", file=sys.stderr)
+        return 3
+    import gc
+
+    gc.freeze()  # the preload's objects are never collected in a child, so never copied for it
+    requests, replies = sys.stdin.buffer, sys.stdout
+    print(json.dumps({"ready": True}), file=replies, flush=True)
+    for line in requests:
+        request = json.loads(line)
+        plan = Path(request["plan"])
+        out, err = plan.with_name(".snippet-stdout"), plan.with_name(".snippet-stderr")
+        sys.stdout.flush()
+        sys.stderr.flush()
+        pid = os.fork()
+        if pid == 0:  # the page's process
+            null = os.open(os.devnull, os.O_RDONLY)
+            os.dup2(null, 0)
+            for fd, path in ((1, out), (2, err)):
+                target = os.open(path, os.O_WRONLY | os.O_CREAT | os.O_TRUNC, 0o644)
+                os.dup2(target, fd)
+                os.close(target)
+            os.close(null)
+            os.chdir(request["cwd"])
+            os.environ.clear()
+            os.environ.update(request["env"])
+            sys.argv = [str(Path(__file__).resolve()), str(plan)]
+            sys.stdin = open(os.devnull)
+            _exit_as_python_would(_run_blocks(plan))
+        deadline, timed_out = time.monotonic() + request["timeout"], False
+        while True:
+            done, status, usage = os.wait4(pid, os.WNOHANG)
+            if done:
+                break
+            if time.monotonic() > deadline:
+                os.kill(pid, signal.SIGKILL)
+                done, status, usage = os.wait4(pid, 0)
+                timed_out = True
+                break
+            time.sleep(0.02)
+        print(json.dumps({"returncode": os.waitstatus_to_exitcode(status), "timed_out": timed_out,
+                          "cpu_seconds": usage.ru_utime + usage.ru_stime, "stdout": str(out), "stderr": str(err)}),
+              file=replies, flush=True)
+    os._exit(0)  # the tests are over; tearing the preload down would cost seconds for nothing
+
+
 if __name__ == "__main__":
-    sys.exit(_run_blocks(Path(sys.argv[1])))
+    sys.exit(_serve() if sys.argv[1:] == ["--serve"] else _run_blocks(Path(sys.argv[1])))

@@ -1,8 +1,9 @@
 """Every Python snippet of README.md and docs/*.md runs, so that none breaks unnoticed when pasted.
 
 One test per page that has ```python blocks: the page's blocks run in order in one fresh
-interpreter, from a scratch folder where `roms/`, `examples/` and `docs/` are the repository's,
-as a reader would run them from a clone (tests/docs/doc_snippets.py). A block whose first line
+process (forked from a page server that imported jax, octax_gym and the rest once, so that no page
+pays for those imports), from a scratch folder where `roms/`, `examples/` and `docs/` are the
+repository's, as a reader would run them from a clone (tests/docs/doc_snippets.py). A block whose first line
 says `not run:` is skipped; the page says why. The harness's own tests come first: a runner that
 could not fail would make every page pass.
 """
@@ -14,9 +15,16 @@ from pathlib import Path
 
 import pytest
 
-from doc_snippets import REPO, pages_with_python, python_blocks, run_page, scratch_clone
+from doc_snippets import REPO, PageServer, pages_with_python, python_blocks, run_page, scratch_clone
 
 PAGES = pages_with_python()
+
+
+@pytest.fixture(scope="module")
+def server(tmp_path_factory):
+    server = PageServer(tmp_path_factory.mktemp("page-server"))
+    yield server
+    server.close()
 
 
 @pytest.fixture
@@ -59,7 +67,7 @@ def test_an_unclosed_fence_is_named(tmp_path):
         python_blocks(page)
 
 
-def test_a_page_runs_in_order_in_one_namespace_from_the_clone(scratch, tmp_path):
+def test_a_page_runs_in_order_in_one_namespace_from_the_clone(scratch, tmp_path, server):
     page = _page(tmp_path, """\
         ```python
         from pathlib import Path
@@ -79,13 +87,13 @@ def test_a_page_runs_in_order_in_one_namespace_from_the_clone(scratch, tmp_path)
         assert n > 0 and VALUE == 42 and __name__ == "__main__"
         ```
         """)
-    result = run_page(page, scratch)
+    result = run_page(page, scratch, server)
     assert result.returncode == 0, result.stderr
     assert "Python block 2 (line 6): skipped, # not run: would fail if it ran" in result.stderr
     assert (scratch / "pkg" / "helper.py").read_text() == "# file: pkg/helper.py\nVALUE = 42\n"  # as the reader saves it
 
 
-def test_a_failing_block_is_reported_with_its_line_and_text(scratch, tmp_path):
+def test_a_failing_block_is_reported_with_its_line_and_text(scratch, tmp_path, server):
     page = _page(tmp_path, """\
         Intro.
 
@@ -102,7 +110,7 @@ def test_a_failing_block_is_reported_with_its_line_and_text(scratch, tmp_path):
         raise AssertionError("never reached: the page stops at its first failure")
         ```
         """)
-    result = run_page(page, scratch)
+    result = run_page(page, scratch, server)
     assert result.returncode == 1
     assert result.stdout == "2.0\n"
     assert "page.md: Python block 2 (line 8) failed:" in result.stderr
@@ -110,6 +118,40 @@ def test_a_failing_block_is_reported_with_its_line_and_text(scratch, tmp_path):
     assert 'File "page.md", line 10' in result.stderr  # the Markdown page's line, not the block's
     assert "   10 | print(key)" in result.stderr
     assert "never reached" not in result.stderr
+
+
+def test_pages_are_independent_processes_of_their_own(server, tmp_path):
+    """What one page does (a JAX backend started, a module or the environment changed, the cwd)
+    never reaches the next page: each is a new process forked from the untouched server."""
+    first = _page(tmp_path, """\
+        ```python
+        import os, jax, octax_gym
+        print(jax.numpy.zeros(2).sum(), os.environ["MINARI_DATASETS_PATH"])
+        octax_gym.LEAKED = True
+        os.environ["OCTAX_LEAKED"] = "1"
+        ```
+        """)
+    (tmp_path / "2").mkdir()
+    second = _page(tmp_path / "2", """\
+        ```python
+        import os, octax_gym, jax
+        from pathlib import Path
+        assert not hasattr(octax_gym, "LEAKED") and "OCTAX_LEAKED" not in os.environ
+        assert Path.cwd().name == "b" and Path("roms").is_dir()
+        print(int(jax.numpy.ones(3).sum()))
+        ```
+        """)
+    runs = [run_page(page, scratch_clone(tmp_path / name), server) for page, name in ((first, "a"), (second, "b"))]
+    assert [r.returncode for r in runs] == [0, 0], runs
+    assert runs[0].stdout == f"0.0 {tmp_path / 'a' / 'minari-datasets'}\n" and runs[1].stdout == "3\n"
+    assert all("fork" not in r.stderr for r in runs), runs  # JAX warns at a fork once a backend runs
+
+
+def test_a_page_over_its_timeout_is_killed_and_named(server, scratch, tmp_path):
+    page = _page(tmp_path, "```python\nimport time\ntime.sleep(60)\n```\n")
+    result = run_page(page, scratch, server, timeout=1)
+    assert result.returncode == -9 and result.seconds < 30
+    assert "page.md: the page did not finish in 1 s and was killed" in result.stderr
 
 
 def test_the_pages_are_the_readme_and_docs_with_python_blocks(tmp_path):
@@ -122,6 +164,6 @@ def test_the_pages_are_the_readme_and_docs_with_python_blocks(tmp_path):
 
 
 @pytest.mark.parametrize("page", PAGES, ids=[page.relative_to(REPO).as_posix() for page in PAGES])
-def test_page_snippets_run(page, scratch):
-    result = run_page(page, scratch)
+def test_page_snippets_run(page, scratch, server):
+    result = run_page(page, scratch, server)
     assert result.returncode == 0, f"{page.relative_to(REPO)}'s snippets failed ({result.seconds:.0f} s):\n{result.stderr[-6000:]}"
