@@ -98,11 +98,11 @@ def test_one_process_with_two_devices_equals_one_device(tmp_path, reference):
 
 
 def test_a_coordinator_that_never_answers_is_a_named_error_not_a_hang():
-    script = ("from octax_gym import distributed\n"
-              f"try:\n    distributed.initialize('127.0.0.1:{free_port()}', 2, 1, timeout_s=3)\n"
+    script = ("from octax_gym import distributed\n"  # the 1 s starts after the imports: no load can beat it
+              f"try:\n    distributed.initialize('127.0.0.1:{free_port()}', 2, 1, timeout_s=1)\n"
               "except distributed.DistributedInitError as e:\n    print('REFUSED', e)\n")
     out = finish(run(["-c", script]), timeout=120)
-    assert "REFUSED process 1 of 2 could not reach the coordinator at 127.0.0.1:" in out and "within 3 s" in out
+    assert "REFUSED process 1 of 2 could not reach the coordinator at 127.0.0.1:" in out and "within 1 s" in out
 
 
 def join(address: str, num_processes: int, rank: int, timeout_s: int):
@@ -166,14 +166,18 @@ def test_a_port_that_answers_but_is_no_coordinator_is_named_on_every_rank():
 
 
 def test_process_0_alone_is_refused_after_the_timeout():
-    out, = refusals([join(f"127.0.0.1:{free_port()}", 3, 0, 3)])
-    assert "process 0 of 3: processes 1, 2 did not join within 3 s" in out, out
+    out, = refusals([join(f"127.0.0.1:{free_port()}", 3, 0, 1)])
+    assert "process 0 of 3: processes 1, 2 did not join within 1 s" in out, out
 
 
 def test_where_jax_still_aborts_the_line_before_it_names_the_cause():
     address = f"127.0.0.1:{free_port()}"  # process 1 shakes hands, then stops before JAX's registration
-    stops = run(["-c", f"from octax_gym import handshake\nhandshake.meet({address!r}, 2, 1, timeout_s=30)\n"])
-    coordinator = join(address, 2, 0, 3)
+    stops = run(["-c", f"from octax_gym import handshake\nprint('MEETING', flush=True)\n"
+                       f"handshake.meet({address!r}, 2, 1, timeout_s=30)\n"])
+    # Process 0 starts once process 1 waits at the handshake, so its 1 s is all JAX's registration's:
+    # no slow import of process 1 can make it a handshake refusal instead.
+    assert stops.stdout.readline() == "MEETING\n"
+    coordinator = join(address, 2, 0, 1)
     finish(stops, timeout=START_UP_TIMEOUT_S)
     try:
         out, _ = coordinator.communicate(timeout=START_UP_TIMEOUT_S)
