@@ -32,6 +32,35 @@ def bench_lines(out: str) -> list[dict[str, str]]:
     return harness.parse_bench_lines(out, "throughput")
 
 
+# The scripts' refusals, run as `python benchmarks/SCRIPT ARGS` runs them (the script as __main__,
+# benchmarks/ first on sys.path, sys.exit's code), several in one subprocess: each refusal comes
+# before any compile, so one JAX import serves them all. A real `python benchmarks/throughput.py`
+# run is test_thin_script_still_runs_without_a_progress_bar's.
+_REFUSALS = """
+import contextlib, io, json, runpy, sys
+sys.path.insert(0, 'benchmarks')
+for script, argv in json.loads(sys.argv[1]):
+    sys.argv, err = [script, *argv], io.StringIO()
+    with contextlib.redirect_stderr(err):
+        try:
+            runpy.run_path(script, run_name='__main__')
+            code = 0
+        except SystemExit as exit:
+            code = exit.code
+    print(json.dumps([code, err.getvalue()]), flush=True)
+"""
+
+
+def script_refusals(cases: list[tuple[str, list[str]]]) -> list[tuple[int, str]]:
+    """(return code, stderr) of each `python benchmarks/SCRIPT ARGV` in `cases`, from one subprocess."""
+    result = subprocess.run([sys.executable, "-c", _REFUSALS, json.dumps(cases)],
+                            capture_output=True, text=True, timeout=300, cwd=REPO, check=False)
+    assert result.returncode == 0, result.stderr
+    outcomes = [tuple(json.loads(line)) for line in result.stdout.splitlines()]
+    assert len(outcomes) == len(cases), result.stdout
+    return outcomes
+
+
 def check_line(fields: dict[str, str], mode: str, n: int, steps: int) -> None:
     assert (fields["mode"], fields["n"], fields["steps"]) == (mode, str(n), str(steps))
     assert int(fields["sps"]) > 0 and int(fields["ips"]) == pytest.approx(int(fields["sps"]) * 44, rel=0.01)
@@ -156,10 +185,23 @@ def test_thin_script_still_runs_without_a_progress_bar():
     assert result.stdout.startswith("# jax ")
 
 
-def test_thin_script_reports_usage_errors():
-    result = subprocess.run([sys.executable, "benchmarks/throughput.py", "--backend", "torch"],
-                            capture_output=True, text=True, timeout=300, cwd=REPO, check=False)
-    assert result.returncode == 2 and "--backend applies to --mode gym only" in result.stderr
+def test_the_scripts_report_usage_errors(tmp_path):
+    (throughput_usage, env_loop_usage, platforms_usage, no_programs, not_chip8) = script_refusals([
+        ("benchmarks/throughput.py", ["--backend", "torch"]),
+        ("benchmarks/env_loop.py", ["--layers", "atari"]),
+        ("benchmarks/platforms.py", ["--platforms", "nes"]),
+        ("benchmarks/platforms.py", ["--platforms", "schip", "--archive", str(tmp_path)]),
+        ("benchmarks/platforms.py", ["--same-program", "--archive-chip8-game", "civiliz8n"])])
+    code, err = throughput_usage
+    assert code == 2 and "--backend applies to --mode gym only" in err
+    code, err = env_loop_usage
+    assert code == 2 and "--layers takes env, gym" in err
+    code, err = platforms_usage
+    assert code == 2 and "unknown platform(s) ['nes']; valid: chip8, schip, xochip" in err
+    code, err = no_programs
+    assert code == 1 and "programs.json" in err
+    code, err = not_chip8
+    assert code == 1 and "'civiliz8n' is not a CHIP-8 program of the archive" in err
 
 
 def test_the_door_names_what_a_wheel_install_lacks(monkeypatch, tmp_path, capsys):
@@ -196,12 +238,6 @@ def test_env_loop_prints_one_line_per_case_against_the_machine_and_octax():
         assert int(line["octax_sps"]) > 0 and float(line["ratio"]) > 0
 
 
-def test_env_loop_usage_errors():
-    result = subprocess.run([sys.executable, "benchmarks/env_loop.py", "--layers", "atari"],
-                            capture_output=True, text=True, timeout=300, cwd=REPO, check=False)
-    assert result.returncode == 2 and "--layers takes env, gym" in result.stderr
-
-
 @pytest.mark.slow  # three platforms' compiles (17 s); the same-program run above covers the three in make test
 def test_platforms_prints_one_line_per_platform_with_its_state_bytes(octax_rom_dir):
     result = subprocess.run(
@@ -230,15 +266,4 @@ def test_platforms_same_program_runs_one_chip8_program_on_every_platform(octax_r
         assert float(chip8["ratio"]) == 1.0
         for line in later:  # the ratio is the platform's instructions/s over chip8's
             assert float(line["ratio"]) == pytest.approx(int(line["ips"]) / int(chip8["ips"]), abs=0.002)
-    result = subprocess.run([sys.executable, "benchmarks/platforms.py", "--same-program", "--archive-chip8-game",
-                             "civiliz8n"], capture_output=True, text=True, timeout=300, cwd=REPO, check=False)
-    assert result.returncode == 1 and "'civiliz8n' is not a CHIP-8 program of the archive" in result.stderr
-
-
-def test_platforms_usage_errors(tmp_path):
-    result = subprocess.run([sys.executable, "benchmarks/platforms.py", "--platforms", "nes"],
-                            capture_output=True, text=True, timeout=300, cwd=REPO, check=False)
-    assert result.returncode == 2 and "unknown platform(s) ['nes']; valid: chip8, schip, xochip" in result.stderr
-    result = subprocess.run([sys.executable, "benchmarks/platforms.py", "--platforms", "schip", "--archive", str(tmp_path)],
-                            capture_output=True, text=True, timeout=300, cwd=REPO, check=False)
-    assert result.returncode == 1 and "programs.json" in result.stderr
+    # its refusal of a game that is not CHIP-8: test_the_scripts_report_usage_errors
