@@ -123,7 +123,9 @@ def test_every_archive_program_is_a_game_or_left_out_with_a_reason():
     assert sorted(list(set(registered)) + left_out) == sorted(programs()), "a program is neither a game nor left out (or both)"
 
 
-@pytest.mark.parametrize("platform", ["chip8", "schip", "xochip"])
+# XO-CHIP's contract runs in make test on Civiliz8n (test_contract_takes_xochip_plane_codes, the
+# same check_env); its cheapest game's in make test-slow.
+@pytest.mark.parametrize("platform", ["chip8", "schip", pytest.param("xochip", marks=pytest.mark.slow)])
 def test_contract_on_one_game_per_platform(platform):
     """The cheapest game of each platform (fewest instructions per frame); every game: tests/archive_games."""
     game_id = min((g for g in ARCHIVE if octax_core.get_spec(g).platform == platform),
