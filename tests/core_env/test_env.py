@@ -23,11 +23,22 @@ def rom_path(tmp_path_factory):
 
 @pytest.fixture(scope="module")
 def counter(rom_path):
-    """make() plus jitted single-env reset/step, built once for the module."""
+    """make() plus jitted single-env reset/step, built (and traced) once per set of overrides for the module."""
+    built = {}
+
     def build(**overrides):
         env, params = octax_core.make(COUNTER, rom=rom_path, **overrides)
-        return env, params, jax.jit(env.reset), jax.jit(env.step)
+        # options that are EnvParams (arguments of the compiled step) share the program of the env
+        # without them: the same config, so the same traced step
+        key = tuple(sorted((k, v) for k, v in overrides.items() if k not in PARAM_OPTIONS))
+        if key not in built:
+            built[key] = env, jax.jit(env.reset), jax.jit(env.step)
+        assert built[key][0].config == env.config
+        return built[key][0], params, *built[key][1:]
     return build
+
+
+PARAM_OPTIONS = {"max_episode_steps", "repeat_action_probability"}
 
 
 def _play(step, state, params, actions):
