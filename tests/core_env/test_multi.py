@@ -188,19 +188,8 @@ def test_sticky_actions_are_per_seat(counters):
     assert state.last_action.shape == (2,)
 
 
-def test_space_racer_seats_move_their_own_ships():
-    env, params = octax_core.make_multi("SpaceRacer")
-    step = jax.jit(env.step)
-    ys = {}
-    for actions in [(0, 0), (1, 0), (0, 1), (1, 1)]:
-        _, state = env.reset(jax.random.key(0), params)
-        for t in range(5):
-            _, state, *_ = step(jax.random.key(t), state, jnp.array(actions), params)
-        ys[actions] = (int(state.machine.V[8]), int(state.machine.V[11]))
-    start = ys[(0, 0)]
-    assert ys[(1, 0)][0] < start[0] and ys[(1, 0)][1] == start[1]
-    assert ys[(0, 1)][1] < start[1] and ys[(0, 1)][0] == start[0]
-    assert ys[(1, 1)] == (ys[(1, 0)][0], ys[(0, 1)][1])
+# Space Racer's seats each move their own ship, one at a time and both at once:
+# tests/core_games/test_two_player_archive.py (test_space_racer_seat_keys_move_their_own_ship).
 
 
 def test_multi_env_is_the_one_player_env_extended():

@@ -6,7 +6,8 @@ score's change, summing to zero where `zero_sum` is declared; in the turn-based 
 Ultimate Tic-tac-toe) the turn passes after each move and the legal mask leaves the other seat
 only no-op, so its keys never reach the machine; the scripted policies beat uniform random play
 from either seat. One jitted rollout per (game, length): the per-step plan of both seats
-(an action, `RANDOM` or `SCRIPTED`) is an argument, NUM_ENVS envs, episodes not reset once done.
+(an action, `RANDOM` or `SCRIPTED`), every env's or each env's own, is an argument, NUM_ENVS
+envs, episodes not reset once done.
 """
 
 from __future__ import annotations
@@ -82,9 +83,16 @@ def _rollout(game_id: str, steps: int):
 
         return jax.lax.scan(body, (state, jnp.bool_(False)), (jax.random.split(run_key, steps), plan))[1]
 
-    run = jax.jit(jax.vmap(one, in_axes=(0, None)))
-    return lambda seed, plan: tuple(np.asarray(x).swapaxes(0, 1) for x in run(
-        jax.random.split(jax.random.key(seed), NUM_ENVS), jnp.asarray(plan, jnp.int32)))
+    run = jax.jit(jax.vmap(one, in_axes=(0, 1)))
+
+    def rollout(seed, plan):
+        """`seed`: an int (env i resets from its own key) or one key, which every env resets from;
+        `plan`: (steps, 2), every env's, or (steps, NUM_ENVS, 2), each env's own."""
+        keys = jax.random.split(jax.random.key(seed), NUM_ENVS) if isinstance(seed, int) else \
+            jnp.stack([seed] * NUM_ENVS)
+        plan = jnp.broadcast_to(jnp.asarray(plan, jnp.int32).reshape(steps, -1, 2), (steps, NUM_ENVS, 2))
+        return tuple(np.asarray(x).swapaxes(0, 1) for x in run(keys, plan))
+    return rollout
 
 
 STEPS = {"SpaceRacer": 120, "TankArchive": 700, "UltimateTicTacToe": 1500, "Paddles": 1500}
@@ -136,22 +144,38 @@ def _plan(steps, first, then=(0, 0), switch=None):
     return plan
 
 
+def _variants(game_id: str, variants) -> np.ndarray:
+    """The per-env plan that gives env j `variants[j]` (a plan (steps, 2)), no-ops to the rest."""
+    plan = np.zeros((STEPS[game_id], NUM_ENVS, 2), np.int32)
+    for j, variant in enumerate(variants):
+        plan[:, j] = variant
+    return plan
+
+
 def test_space_racer_seat_keys_move_their_own_ship():
-    run = _rollout("SpaceRacer", STEPS["SpaceRacer"])
+    """Env 0: seat 0 up then down; env 1: seat 1 the same; env 2: both up: all from one start."""
+    steps = STEPS["SpaceRacer"]
+    plan = _variants("SpaceRacer", [_plan(steps, (1, 0), (2, 0), switch=40), _plan(steps, (0, 1), (0, 2), switch=40),
+                                    _plan(steps, (1, 1), (0, 0), switch=5)])
+    probe = _rollout("SpaceRacer", steps)(jax.random.key(0), plan)[4]
     ship1, ship2 = 0, 1
-    for seat, up, down in ((0, (1, 0), (2, 0)), (1, (0, 1), (0, 2))):
-        probe = run(0, _plan(STEPS["SpaceRacer"], up, down, switch=40))[4][:, 0]  # env 0
-        own, other = probe[:, (ship1, ship2)[seat]], probe[:, (ship2, ship1)[seat]]
+    for seat in (0, 1):
+        own, other = probe[:, seat, (ship1, ship2)[seat]], probe[:, seat, (ship2, ship1)[seat]]
         assert (other == other[0]).all(), f"seat {seat}'s keys moved the other ship"
         assert own[:40].min() < own[0], f"seat {seat}'s up key (4 / D) did not raise its ship"
         assert own[-1] > own[40], f"seat {seat}'s down key (7 / E) did not lower its ship"
+    # both seats at once: each ship where its own seat alone put it (5 steps up, no collision yet)
+    assert probe[4, 2, ship1] == probe[4, 0, ship1] < probe[0, 2, ship1]
+    assert probe[4, 2, ship2] == probe[4, 1, ship2] < probe[0, 2, ship2]
 
 
 def test_paddles_seat_keys_move_their_own_paddle():
-    run = _rollout("Paddles", STEPS["Paddles"])
-    for seat, left, right in ((0, (1, 0), (2, 0)), (1, (0, 1), (0, 2))):
-        probe = run(0, _plan(STEPS["Paddles"], left, right, switch=20))[4][:40, 0]
-        own, other = probe[:, seat], probe[:, 1 - seat]
+    """Env 0: seat 0 left then right; env 1: seat 1 the same; from one start."""
+    steps = STEPS["Paddles"]
+    plan = _variants("Paddles", [_plan(steps, (1, 0), (2, 0), switch=20), _plan(steps, (0, 1), (0, 2), switch=20)])
+    probe = _rollout("Paddles", steps)(jax.random.key(0), plan)[4][:40]
+    for seat in (0, 1):
+        own, other = probe[:, seat, seat], probe[:, seat, 1 - seat]
         assert (other == 32).all(), f"seat {seat}'s keys moved the other paddle"
         assert (np.diff(own[:20]) <= 0).all() and own[19] <= 20, own  # keys 4 / 7: left, 2 pixels a pass
         assert (np.diff(own[20:]) >= 0).all() and own[-1] > own[19] + 10, own  # keys 6 / 9: right
