@@ -258,7 +258,10 @@ def _serve() -> int:
     import importlib
 
     for name in PRELOAD:
-        importlib.import_module(name)
+        try:
+            importlib.import_module(name)
+        except ImportError:  # not installed here (torch without the torch extra): a page that needs it says so
+            pass
     from jax._src import xla_bridge
 
     # A fork is only safe from a single-threaded process: JAX's backends start threads (and JAX
