@@ -178,17 +178,25 @@ def test_state_shapes_per_platform():
     assert snap["screen"].shape == (64, 128) and "plane" not in snap and not snap["hires"] and not snap["exited"]
 
 
-def test_render_text_per_platform():
-    # a hires pixel at (3, 1) on plane 1, (4, 1) on plane 2, (5, 1) on both
+def run_instructions(execute, state, count):
+    for _ in range(count):
+        state = execute(state, 0)
+    return state
+
+
+def test_render_text_per_platform(jit_execute):
+    # a hires pixel at (3, 1) on plane 1, (4, 1) on plane 2, (5, 1) on both (the hand programs'
+    # compiled `execute` runs the 12 instructions)
     rom = assemble(0x00FF, 0x6003, 0x6101, 0xA21A, 0xF101, 0xD011, 0x6004, 0xF201, 0xD011, 0x6005, 0xF301, 0xD011,
                    0x1218) + b"\x80\x80"
     machine = octax_core.Machine("xochip")
-    state = machine.run_frames(machine.boot(rom, jax.random.key(0)), 0, 2)
+    state = run_instructions(jit_execute(machine), machine.boot(rom, jax.random.key(0)), 12)
     lines = octax_core.render_text(state).splitlines()
     assert len(lines) == 64 and {len(line) for line in lines} == {128}
     assert lines[1][:8] == "...123.." and set("".join(lines[2:])) == {"."}
     schip = octax_core.Machine("schip")
-    text = octax_core.render_text(schip.run_frames(schip.boot(assemble(0xA20A, 0xD001, 0x1204, 0, 0) + b"\x80", jax.random.key(0)), 0, 1))
+    text = octax_core.render_text(run_instructions(
+        jit_execute(schip), schip.boot(assemble(0xA20A, 0xD001, 0x1204, 0, 0) + b"\x80", jax.random.key(0)), 2))
     assert text.splitlines()[0][:3] == "##." and text.splitlines()[1][:3] == "##." and len(text.splitlines()) == 64
     batch = jax.vmap(schip.boot, in_axes=(None, 0))(b"\x12\x00", jax.random.split(jax.random.key(0), 2))
     with pytest.raises(ValueError, match="one machine's state"):
@@ -207,12 +215,18 @@ def test_poke_on_xochip_reaches_high_memory_and_keeps_the_mirror():
 
 def test_exit_stands_still_and_an_env_can_read_it(jit_run_frames):
     # delay := 10; 00FD: the exit's own frame ticks the timer, later frames change nothing
+    # (one frame a call, as the recorded-screens test below runs it: one compile for both)
     machine = octax_core.Machine("schip", instructions_per_frame=5)
     state = machine.boot(assemble(0x600A, 0xF015, 0x00FD, 0x6142), jax.random.key(0))
-    run = jit_run_frames(machine)
-    state = run(state, 0, 1)
+
+    def run(state, keys):
+        return jit_run_frames(machine)(state, jnp.uint32(keys), 1, halted=jnp.bool_(False))
+
+    state = run(state, 0)
     assert bool(state.exited) and int(state.pc) == START + 4 and int(state.delay_timer) == 9
-    later = run(state, 0xFFFF, 5)
+    later = state
+    for _ in range(5):
+        later = run(later, 0xFFFF)
     assert all(np.array_equal(a, b) for a, b in zip(jax.tree.leaves(state), jax.tree.leaves(later)))
 
 
@@ -229,13 +243,14 @@ def test_batches_run_each_machine_as_alone(jit_run_frames):
     assert octax_core.snapshot(batch)["screen"].shape == (3, 2, 64, 128)
 
 
-def test_record_screens_has_the_platform_shape(jit_run_frames):
-    machine = octax_core.Machine("schip")
-    state, screens = machine.run_frames(machine.boot(b"\x12\x00", jax.random.key(0)), 0, 3, record_screens=True)
+def test_record_screens_has_the_platform_shape():
+    machine = octax_core.Machine("schip")  # the traced program's output, without compiling it
+    state, screens = jax.eval_shape(lambda s: machine.run_frames(s, 0, 3, record_screens=True),
+                                    machine.boot(b"\x12\x00", jax.random.key(0)))
     assert screens.shape == (3, 1, 64, 4) and screens.dtype == jnp.uint32
 
 
-def test_recorded_screens_are_each_frames_picture_through_an_exit_and_a_halt():
+def test_recorded_screens_are_each_frames_picture_through_an_exit_and_a_halt(jit_run_frames):
     # One recorded call of 5 frames equals 5 one-frame calls, picture by picture, for a batch of
     # a machine that exits in its fourth frame (key A held: the frames after show its last
     # picture), one that runs on drawing (no key), and one halted (all five show its picture).
@@ -243,11 +258,15 @@ def test_recorded_screens_are_each_frames_picture_through_an_exit_and_a_halt():
     machine = octax_core.Machine("schip", instructions_per_frame=5)
     keys = jnp.array([1 << 0xA, 0, 0], jnp.uint32)
     halted = jnp.array([False, False, True])
-    boot = jax.vmap(lambda k: machine.boot(rom, k))(jax.random.split(jax.random.key(3), 3))
-    boot = jax.jit(jax.vmap(lambda s, k: machine.run_frames(s, k, 1)))(boot, jnp.array([0, 0, 1 << 0xA], jnp.uint32))
+
+    def one(state, keys, halted):
+        return jit_run_frames(machine)(state, keys, 1, halted=halted)
+
+    boot = [one(machine.boot(rom, k), key, jnp.bool_(False))
+            for k, key in zip(jax.random.split(jax.random.key(3), 3), jnp.array([0, 0, 1 << 0xA], jnp.uint32))]
+    boot = jax.tree.map(lambda *leaves: jnp.stack(leaves), *boot)
     state, screens = jax.jit(jax.vmap(lambda s, k, h: machine.run_frames(s, k, 5, halted=h, record_screens=True)))(
         boot, keys, halted)
-    one = jax.jit(lambda s, k, h: machine.run_frames(s, k, 1, halted=h))
     for i in range(3):
         alone = jax.tree.map(lambda leaf: leaf[i], boot)
         for frame in range(5):

@@ -193,7 +193,7 @@ class SuiteRun:
     """A Timendus ROM with its mode byte set, on the reference ("reference") or the JAX core
     ("core"): the same verdicts must hold on both."""
 
-    def __init__(self, impl, rom, mode, platform, ipf):
+    def __init__(self, impl, rom, mode, platform, ipf, jit_run_frames):
         data = (st.SUITE / f"{rom}.ch8").read_bytes()
         self.impl = impl
         if impl == "reference":
@@ -204,7 +204,7 @@ class SuiteRun:
             import octax_core
             machine = octax_core.Machine(platform, instructions_per_frame=ipf)
             self.state = octax_core.poke(machine.boot(data, jax.random.key(0)), 0x1FF, bytes([mode]))
-            self.run = jax.jit(machine.run_frames, static_argnums=2)
+            self.run = jit_run_frames(machine)  # shared by the modes of a platform: one compile
 
     def frames(self, count):
         if self.impl == "reference":
@@ -232,8 +232,8 @@ IMPLEMENTATIONS = ("reference", "core")
 @pytest.mark.shared
 @pytest.mark.parametrize("impl", IMPLEMENTATIONS)
 @pytest.mark.parametrize("mode, platform", [(2, "schip"), (3, "xochip")])
-def test_quirks_rom_passes_every_quirk(mode, platform, impl):
-    run = SuiteRun(impl, "5-quirks", mode, platform, ipf=30)
+def test_quirks_rom_passes_every_quirk(mode, platform, impl, jit_run_frames):
+    run = SuiteRun(impl, "5-quirks", mode, platform, 30, jit_run_frames)
     for _ in range(15 * 6):
         run.frames(10)
         if st.mark_at(run.screen(), 59, 27, FLAG_OK, FLAG_ERR) != "missing":
@@ -279,9 +279,9 @@ def border_pixels(mode):
 @pytest.mark.shared
 @pytest.mark.parametrize("impl", IMPLEMENTATIONS)
 @pytest.mark.parametrize("mode, platform", [(1, "schip"), (3, "schip"), (4, "xochip"), (5, "xochip")])
-def test_scrolling_rom_puts_every_arrow_in_a_box(mode, platform, impl):
+def test_scrolling_rom_puts_every_arrow_in_a_box(mode, platform, impl, jit_run_frames):
     source = (st.SUITE / "8-scrolling.8o").read_text()
-    run = SuiteRun(impl, "8-scrolling", mode, platform, ipf=100)
+    run = SuiteRun(impl, "8-scrolling", mode, platform, 100, jit_run_frames)
     run.frames(120)
     screen = run.screen()
     on = {(x, y) for y, x in zip(*np.nonzero(screen))}
