@@ -29,6 +29,16 @@ FRAMES = 4
 INSTRUCTIONS_PER_FRAME = 11
 PROGRAM_START = 0x200
 SETTINGS = settings(max_examples=100, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+# `make test` runs each property with FAST_EXAMPLES fresh examples, `make test-slow` with all of
+# SETTINGS's too (the `_all_examples` twins): the same property, a smaller sample of it per run.
+FAST_EXAMPLES = 30
+
+
+def fast_and_full(test, parametrize):
+    """The property `test` (given-decorated, unsettled) as two pytest tests: FAST_EXAMPLES
+    examples, and SETTINGS's count marked slow."""
+    fast = parametrize(settings(SETTINGS, max_examples=FAST_EXAMPLES)(test()))
+    return fast, pytest.mark.slow(parametrize(SETTINGS(test())))
 
 
 @functools.lru_cache(maxsize=None)
@@ -113,13 +123,17 @@ def boot_both(rom, quirks, seed):
 
 # ---- properties ----------------------------------------------------------------------------------
 
-@pytest.mark.parametrize("quirk_set", QUIRK_SETS)
-@SETTINGS
-@given(rom=programs(), keys=st.lists(key_mask, min_size=STEPS, max_size=STEPS),
-       seed=st.integers(0, 2**32 - 1))
-def test_instructions_match_reference(quirk_set, rom, keys, seed):
-    machine, state, ref = boot_both(rom, QUIRK_SETS[quirk_set], seed)
-    assert_instructions_match(quirk_set, machine, state, ref, keys, rom)
+def instructions_property():
+    @given(rom=programs(), keys=st.lists(key_mask, min_size=STEPS, max_size=STEPS),
+           seed=st.integers(0, 2**32 - 1))
+    def test_instructions_match_reference(quirk_set, rom, keys, seed):
+        machine, state, ref = boot_both(rom, QUIRK_SETS[quirk_set], seed)
+        assert_instructions_match(quirk_set, machine, state, ref, keys, rom)
+    return test_instructions_match_reference
+
+
+test_instructions_match_reference, test_instructions_match_reference_all_examples = fast_and_full(
+    instructions_property, pytest.mark.parametrize("quirk_set", QUIRK_SETS))
 
 
 def assert_instructions_match(label, machine, state, ref, keys, rom):
@@ -147,10 +161,14 @@ def assert_frames_match(label, run, state, ref, keys, rom):
             f"  program: {listing(rom)}")
 
 
-@pytest.mark.parametrize("quirk_set", QUIRK_SETS)
-@SETTINGS
-@given(rom=programs(), keys=st.lists(key_mask, min_size=FRAMES, max_size=FRAMES),
-       seed=st.integers(0, 2**32 - 1))
-def test_frames_match_reference(quirk_set, rom, keys, seed, jit_run_frames):
-    machine, state, ref = boot_both(rom, QUIRK_SETS[quirk_set], seed)
-    assert_frames_match(quirk_set, jit_run_frames(machine), state, ref, keys, rom)
+def frames_property():
+    @given(rom=programs(), keys=st.lists(key_mask, min_size=FRAMES, max_size=FRAMES),
+           seed=st.integers(0, 2**32 - 1))
+    def test_frames_match_reference(quirk_set, rom, keys, seed, jit_run_frames):
+        machine, state, ref = boot_both(rom, QUIRK_SETS[quirk_set], seed)
+        assert_frames_match(quirk_set, jit_run_frames(machine), state, ref, keys, rom)
+    return test_frames_match_reference
+
+
+test_frames_match_reference, test_frames_match_reference_all_examples = fast_and_full(
+    frames_property, pytest.mark.parametrize("quirk_set", QUIRK_SETS))

@@ -31,6 +31,12 @@ FRAMES = 4
 INSTRUCTIONS_PER_FRAME = 11
 PROGRAM_START = 0x200
 SETTINGS = settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+FAST_EXAMPLES = 20  # in make test; make test-slow runs SETTINGS's count too (the `_all_examples` twins)
+
+
+def fast_and_full(test, parametrize):
+    fast = parametrize(settings(SETTINGS, max_examples=FAST_EXAMPLES)(test()))
+    return fast, pytest.mark.slow(parametrize(SETTINGS(test())))
 
 schip_only = [
     st.sampled_from([0x00FB, 0x00FC, 0x00FE, 0x00FF, 0x00FF]),
@@ -88,19 +94,27 @@ def case_programs(case):
     return programs(CASES[case][0])
 
 
-@pytest.mark.parametrize("case", CASES)
-@SETTINGS
-@given(data=st.data(), keys=st.lists(key_mask, min_size=STEPS, max_size=STEPS), seed=st.integers(0, 2**32 - 1))
-def test_instructions_match_reference(case, data, keys, seed):
-    rom = data.draw(case_programs(case), label="rom")
-    machine, state, ref = boot_both(rom, case, seed)
-    assert_instructions_match(case, machine, state, ref, keys, rom)
+def instructions_property():
+    @given(data=st.data(), keys=st.lists(key_mask, min_size=STEPS, max_size=STEPS), seed=st.integers(0, 2**32 - 1))
+    def test_instructions_match_reference(case, data, keys, seed):
+        rom = data.draw(case_programs(case), label="rom")
+        machine, state, ref = boot_both(rom, case, seed)
+        assert_instructions_match(case, machine, state, ref, keys, rom)
+    return test_instructions_match_reference
 
 
-@pytest.mark.parametrize("case", CASES)
-@SETTINGS
-@given(data=st.data(), keys=st.lists(key_mask, min_size=FRAMES, max_size=FRAMES), seed=st.integers(0, 2**32 - 1))
-def test_frames_match_reference(case, data, keys, seed, jit_run_frames):
-    rom = data.draw(case_programs(case), label="rom")
-    machine, state, ref = boot_both(rom, case, seed)
-    assert_frames_match(case, jit_run_frames(machine), state, ref, keys, rom)
+test_instructions_match_reference, test_instructions_match_reference_all_examples = fast_and_full(
+    instructions_property, pytest.mark.parametrize("case", CASES))
+
+
+def frames_property():
+    @given(data=st.data(), keys=st.lists(key_mask, min_size=FRAMES, max_size=FRAMES), seed=st.integers(0, 2**32 - 1))
+    def test_frames_match_reference(case, data, keys, seed, jit_run_frames):
+        rom = data.draw(case_programs(case), label="rom")
+        machine, state, ref = boot_both(rom, case, seed)
+        assert_frames_match(case, jit_run_frames(machine), state, ref, keys, rom)
+    return test_frames_match_reference
+
+
+test_frames_match_reference, test_frames_match_reference_all_examples = fast_and_full(
+    frames_property, pytest.mark.parametrize("case", CASES))
