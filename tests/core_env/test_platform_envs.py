@@ -49,9 +49,9 @@ def test_xochip_observation_keeps_four_colours_apart(tmp_path):
     spec, path = xochip_game(tmp_path)
     for scale, values in ((1, (3, 1, 2)), (255, (255, 85, 170))):
         env, params = octax_core.make(spec, rom=path, obs_scale=scale, frames_per_step=2)
-        obs, state = env.reset(jax.random.key(0), params)  # the boot screen: dark
+        obs, state = jax.jit(env.reset)(jax.random.key(0), params)  # the boot screen: dark
         assert obs.shape == (2, 64, 128) == env.observation_shape and not obs.any()
-        obs = env.step(jax.random.key(1), state, 0, params)[0]
+        obs = jax.jit(env.step)(jax.random.key(1), state, 0, params)[0]
         assert obs.shape == (2, 64, 128) and obs.dtype == jnp.uint8
         assert tuple(int(v) for v in obs[-1, 0, [0, 2, 4]]) == values
         assert int(np.count_nonzero(np.asarray(obs[-1]))) == 3
@@ -61,8 +61,8 @@ def test_xochip_observation_keeps_four_colours_apart(tmp_path):
 def test_schip_lores_pixels_fill_2x2_blocks_of_the_one_shape(tmp_path):
     spec, path = schip_game(tmp_path)
     env, params = octax_core.make(spec, rom=path, obs_scale=255)
-    obs, state = env.reset(jax.random.key(0), params)
-    obs = env.step(jax.random.key(1), state, 0, params)[0]
+    obs, state = jax.jit(env.reset)(jax.random.key(0), params)
+    obs = jax.jit(env.step)(jax.random.key(1), state, 0, params)[0]
     assert obs.shape == (4, 64, 128) and env.observation_high == 255
     assert set(zip(*np.nonzero(np.asarray(obs[-1])))) == {(2, 6), (2, 7), (3, 6), (3, 7)}
     assert int(obs[-1, 2, 6]) == 255
@@ -73,7 +73,7 @@ def test_exit_ends_the_episode_and_the_machine_stands_still(tmp_path, make_game)
     spec, path = make_game(tmp_path)
     env, params = octax_core.make(spec, rom=path)
     step = jax.jit(env.step)
-    obs, state = env.reset(jax.random.key(0), params)
+    obs, state = jax.jit(env.reset)(jax.random.key(0), params)
     obs, state, reward, terminated, truncated, info = step(jax.random.key(1), state, 0, params)
     assert float(reward) > 0 and not bool(terminated)
     obs, state, reward, terminated, truncated, info = step(jax.random.key(2), state, 1, params)
