@@ -25,17 +25,9 @@ from stable_baselines3.common.save_util import data_to_json  # noqa: E402
 
 from octax_gym.play.agents import load_agent  # noqa: E402
 from octax_gym.sb3 import OctaxCNNExtractor, ppo_kwargs  # noqa: E402
+from torch_threads import one_torch_thread  # noqa: E402,F401  (autouse: one torch thread)
 
 FRAMES, ACTIONS = 4, 3
-
-
-@pytest.fixture(autouse=True)
-def one_torch_thread():
-    """These networks are tiny: on a busy machine torch's thread pool makes each call ~30x slower."""
-    threads = torch.get_num_threads()
-    torch.set_num_threads(1)
-    yield
-    torch.set_num_threads(threads)
 
 
 class Frames(gymnasium.Env):

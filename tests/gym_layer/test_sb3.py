@@ -26,17 +26,9 @@ from stable_baselines3.common.vec_env import (VecFrameStack, VecMonitor, VecTran
 from counter_game import COUNTER
 from octax_gym import OctaxVectorEnv
 from octax_gym.sb3 import PPO_KWARGS, OctaxCNNExtractor, OctaxSB3VecEnv, make_sb3_vec_env, ppo_kwargs
+from torch_threads import one_torch_thread  # noqa: E402,F401  (autouse: one torch thread)
 
 ACTIONS = np.array([2, 1], np.int64)  # SB3 hands over int64 actions
-
-
-@pytest.fixture(autouse=True)
-def one_torch_thread():
-    """Two torch threads on a loaded 2-core machine made each PPO update ~100x slower."""
-    threads = torch.get_num_threads()
-    torch.set_num_threads(1)
-    yield
-    torch.set_num_threads(threads)
 
 
 def counter(counter_rom, monitor=False, **kw):
