@@ -83,6 +83,26 @@ def counter_rom(tmp_path_factory) -> Path:
 
 
 @pytest.fixture(scope="session")
+def two_counters_rom(tmp_path_factory) -> Path:
+    """tests/two_player_games.py's TwoCounters (a simultaneous two-player game) as a ROM file."""
+    from two_player_games import TWO_COUNTERS_ROM
+
+    path = tmp_path_factory.mktemp("two_counters") / "two_counters.ch8"
+    path.write_bytes(TWO_COUNTERS_ROM)
+    return path
+
+
+@pytest.fixture(scope="session")
+def take_turns_rom(tmp_path_factory) -> Path:
+    """tests/two_player_games.py's TakeTurns (a turn-based two-player game) as a ROM file."""
+    from two_player_games import TAKE_TURNS_ROM
+
+    path = tmp_path_factory.mktemp("take_turns") / "take_turns.ch8"
+    path.write_bytes(TAKE_TURNS_ROM)
+    return path
+
+
+@pytest.fixture(scope="session")
 def test_suite_dir() -> Path:
     """The Timendus test suite in ../shared (tests using it are marked `shared` too)."""
     why = missing_shared(TEST_SUITE_DIR)

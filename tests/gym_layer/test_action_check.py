@@ -249,15 +249,6 @@ def _refused(envs, actions, message):
     return rewards
 
 
-@pytest.fixture(scope="module")
-def two_counters_rom(tmp_path_factory):
-    from two_player_games import TWO_COUNTERS_ROM
-
-    path = tmp_path_factory.mktemp("two_counters") / "two_counters.ch8"
-    path.write_bytes(TWO_COUNTERS_ROM)
-    return path
-
-
 @pytest.mark.parametrize("backend", BACKENDS)
 @pytest.mark.parametrize("kind", KINDS)
 @pytest.mark.parametrize("value", BAD)

@@ -48,6 +48,17 @@ def assert_clean_failure(done: subprocess.CompletedProcess, root: Path) -> None:
     assert [p.name for p in root.rglob("*.tmp")] == []
 
 
+def write_error(root: Path, mode: str) -> str:
+    """Runs the worker's synthetic dataset `mode` past the size limit: a clean failure, with
+    `DatasetWriteError` (EFBIG) raised; returns its message."""
+    done = run_worker(root, mode)
+    assert_clean_failure(done, root)
+    assert done.returncode == 3, (done.stdout, done.stderr[-3000:])
+    raised, message = done.stdout.strip().splitlines()[-2:]
+    assert raised == f"raised DatasetWriteError {errno.EFBIG}"
+    return message
+
+
 def load(root: Path, monkeypatch, dataset_id: str = synthetic.DATASET_ID):
     monkeypatch.setenv("MINARI_DATASETS_PATH", str(root))
     return minari.load_dataset(dataset_id)
@@ -62,11 +73,7 @@ def assert_synthetic_episodes(dataset, episodes: int) -> None:
 
 
 def test_a_part_past_the_limit_is_a_named_error_and_the_parts_before_it_stay(tmp_path, monkeypatch):
-    done = run_worker(tmp_path, "part")
-    assert_clean_failure(done, tmp_path)
-    assert done.returncode == 3, (done.stdout, done.stderr[-3000:])
-    raised, message = done.stdout.strip().splitlines()[-2:]
-    assert raised == f"raised DatasetWriteError {errno.EFBIG}"
+    message = write_error(tmp_path, "part")
     assert message.startswith("file too large writing ") and "part-00001.hdf5" in message, message
     assert f"the {PER_FLUSH} episodes" in message and "are kept" in message, message
     assert_synthetic_episodes(load(tmp_path, monkeypatch), PER_FLUSH)
@@ -76,11 +83,7 @@ def test_a_part_past_the_limit_is_a_named_error_and_the_parts_before_it_stay(tmp
 
 
 def test_a_one_file_copy_past_the_limit_keeps_every_episode_in_its_parts(tmp_path, monkeypatch):
-    done = run_worker(tmp_path, "finish")
-    assert_clean_failure(done, tmp_path)
-    assert done.returncode == 3, (done.stdout, done.stderr[-3000:])
-    raised, message = done.stdout.strip().splitlines()[-2:]
-    assert raised == f"raised DatasetWriteError {errno.EFBIG}"
+    message = write_error(tmp_path, "finish")
     assert "main_data.hdf5" in message and "dataset finish" in message, message
     all_episodes = synthetic.FLUSHES * PER_FLUSH
     data = tmp_path / synthetic.DATASET_ID / "data"

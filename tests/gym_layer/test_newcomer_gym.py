@@ -25,7 +25,7 @@ from octax_gym import OctaxEnv, OctaxVectorEnv, UnknownOptionError
 from octax_gym.game_names import resolve_spec
 
 from counter_game import COUNTER
-from two_player_games import TAKE_TURNS, TAKE_TURNS_ROM, TWO_COUNTERS, TWO_COUNTERS_ROM
+from two_player_games import TAKE_TURNS, TWO_COUNTERS
 
 REPO = Path(__file__).resolve().parents[2]
 BOUND = COUNTER.max_episode_steps  # 50
@@ -34,14 +34,6 @@ BOUND = COUNTER.max_episode_steps  # 50
 @pytest.fixture(scope="module")
 def counter_id(counter_rom):
     return octax_gym.register_game(COUNTER, rom=counter_rom)
-
-
-@pytest.fixture(scope="module")
-def roms(tmp_path_factory):
-    folder = tmp_path_factory.mktemp("two_player")
-    (folder / "turns.ch8").write_bytes(TAKE_TURNS_ROM)
-    (folder / "counters.ch8").write_bytes(TWO_COUNTERS_ROM)
-    return folder
 
 
 def steps_to_truncation(env, limit: int) -> int:
@@ -111,12 +103,12 @@ def _chain(env):
 
 # --- get_action_meanings ------------------------------------------------------------------------
 
-def test_action_meanings_name_no_op_and_each_action_s_key(counter_rom, counter_id, roms):
+def test_action_meanings_name_no_op_and_each_action_s_key(counter_rom, counter_id, two_counters_rom):
     env = gym.make(counter_id)
     assert env.unwrapped.get_action_meanings() == ["NOOP", "KEY_1", "KEY_2"]
     assert len(env.unwrapped.get_action_meanings()) == env.action_space.n
     env.close()
-    learner = OctaxEnv(TWO_COUNTERS, rom=roms / "counters.ch8", opponent="noop", seat=1)
+    learner = OctaxEnv(TWO_COUNTERS, rom=two_counters_rom, opponent="noop", seat=1)
     assert learner.get_action_meanings() == ["NOOP", "KEY_4", "KEY_5"]  # the learner seat's keys
     assert octax_gym.env.action_meanings(get_spec("Pong")) == ["NOOP"] + [f"KEY_{k:X}" for k in
                                                                          get_spec("Pong").action_keys]
@@ -141,13 +133,13 @@ def test_human_rendering_is_refused_at_make_naming_the_alternatives(counter_id, 
 
 # --- action masks ---------------------------------------------------------------------------------
 
-def test_the_one_seat_views_masks_are_int8_and_sample_legal_actions(roms):
-    env = OctaxEnv(TAKE_TURNS, rom=roms / "turns.ch8", opponent="noop", seat=1)
+def test_the_one_seat_views_masks_are_int8_and_sample_legal_actions(take_turns_rom):
+    env = OctaxEnv(TAKE_TURNS, rom=take_turns_rom, opponent="noop", seat=1)
     _, info = env.reset(seed=0)
     assert info["action_mask"].dtype == np.int8 and info["action_mask"].tolist() == [1, 0]  # seat 0 moves first
     assert env.action_space.sample(mask=info["action_mask"]) == 0
     assert env.action_masks().dtype == np.bool_  # what MaskablePPO reads
-    envs = OctaxVectorEnv(TAKE_TURNS, 3, rom=roms / "turns.ch8", opponent="random")
+    envs = OctaxVectorEnv(TAKE_TURNS, 3, rom=take_turns_rom, opponent="random")
     _, info = envs.reset(seed=0)
     assert info["action_mask"].dtype == np.int8
     for _ in range(6):

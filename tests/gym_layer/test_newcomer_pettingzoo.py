@@ -14,7 +14,7 @@ import pytest
 pytest.importorskip("pettingzoo")
 from octax_gym import pettingzoo as octax_pz  # noqa: E402
 
-from two_player_games import TAKE_TURNS, TAKE_TURNS_ROM, TURNS_GOAL  # noqa: E402
+from two_player_games import TAKE_TURNS, TURNS_GOAL  # noqa: E402
 
 # Player 1's lives, as a one-player spec counts them (Duel's and Cycles' `lives_fn` are so): the
 # rounds player 2 still needs to win.
@@ -22,10 +22,8 @@ WITH_LIVES = dataclasses.replace(TAKE_TURNS, lives_fn=lambda s: TURNS_GOAL - s.V
 
 
 @pytest.fixture(scope="module")
-def rom(tmp_path_factory):
-    path = tmp_path_factory.mktemp("take_turns") / "take_turns.ch8"
-    path.write_bytes(TAKE_TURNS_ROM)
-    return path
+def rom(take_turns_rom):
+    return take_turns_rom
 
 
 def test_lives_are_per_seat_and_a_seat_without_a_count_says_so(rom):
