@@ -12,22 +12,18 @@ import octax_core
 from octax_core.env.multi import MultiEnv
 
 from counter_game import COUNTER
-from two_player_games import GOAL, TAKE_TURNS, TAKE_TURNS_ROM, TURNS_GOAL, TWO_COUNTERS, TWO_COUNTERS_ROM
+from two_player_games import GOAL, TAKE_TURNS, TURNS_GOAL, TWO_COUNTERS
 
 
 @pytest.fixture(scope="module")
-def counters(tmp_path_factory):
-    path = tmp_path_factory.mktemp("roms") / "two_counters.ch8"
-    path.write_bytes(TWO_COUNTERS_ROM)
-    env, params = octax_core.make_multi(TWO_COUNTERS, rom=path)
-    return env, params, jax.jit(env.step), path
+def counters(two_counters_rom):
+    env, params = octax_core.make_multi(TWO_COUNTERS, rom=two_counters_rom)
+    return env, params, jax.jit(env.step), two_counters_rom
 
 
 @pytest.fixture(scope="module")
-def turns(tmp_path_factory):
-    path = tmp_path_factory.mktemp("roms") / "take_turns.ch8"
-    path.write_bytes(TAKE_TURNS_ROM)
-    env, params = octax_core.make_multi(TAKE_TURNS, rom=path)
+def turns(take_turns_rom):
+    env, params = octax_core.make_multi(TAKE_TURNS, rom=take_turns_rom)
     return env, params, jax.jit(env.step)
 
 

@@ -24,7 +24,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "examples"))
 import train_jax_selfplay as sp  # noqa: E402
 
 import octax_core  # noqa: E402
-from two_player_games import GOAL, TWO_COUNTERS, TWO_COUNTERS_ROM  # noqa: E402
+from two_player_games import GOAL, TWO_COUNTERS  # noqa: E402
 
 TIMING = ("wall_s", "env_steps_per_s")
 TINY = sp.Config(game="TwoCounters", num_envs=4, num_steps=8, num_minibatches=2, update_epochs=2,
@@ -46,10 +46,8 @@ class Tiny(nn.Module):
 
 
 @pytest.fixture(scope="module")
-def rom(tmp_path_factory) -> Path:
-    path = tmp_path_factory.mktemp("roms") / "two_counters.ch8"
-    path.write_bytes(TWO_COUNTERS_ROM)
-    return path
+def rom(two_counters_rom) -> Path:
+    return two_counters_rom
 
 
 @pytest.fixture(scope="module")

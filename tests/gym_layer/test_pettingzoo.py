@@ -18,7 +18,7 @@ import octax_core  # noqa: E402
 from octax_gym import IllegalMoveError, InvalidActionError  # noqa: E402
 from octax_gym import pettingzoo as octax_pz  # noqa: E402
 
-from two_player_games import TAKE_TURNS, TAKE_TURNS_ROM  # noqa: E402
+from two_player_games import TAKE_TURNS  # noqa: E402
 
 FAST = ("SpaceRacer",)
 GAMES = ["TakeTurns", *FAST] + [pytest.param(game, marks=pytest.mark.slow)
@@ -27,10 +27,8 @@ CYCLES = 100
 
 
 @pytest.fixture(scope="module")
-def turns_rom(tmp_path_factory):
-    path = tmp_path_factory.mktemp("take_turns") / "take_turns.ch8"
-    path.write_bytes(TAKE_TURNS_ROM)
-    return path
+def turns_rom(take_turns_rom):
+    return take_turns_rom
 
 
 @pytest.fixture
