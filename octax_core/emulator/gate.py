@@ -16,7 +16,8 @@ back to the host before each trip (a device-to-host sync; an instruction has two
 write and the rare work, and four more inside the second), which cost more than the work it
 skips: there the work simply runs for the whole batch, which the contract makes the same.
 `LOOPED_PLATFORMS` names where the gate loops; `jax.lax.platform_dependent` picks per platform
-when the program is lowered, so one traced program serves both; `where_looped` makes the same
+when the program is lowered, so one traced program serves both (on a host whose backends are all
+of one kind, only that kind's form is traced); `where_looped` makes the same
 choice for work around a gate (`cpu._draw` reads plane 1's collision before the rare work where
 the gate loops, after it elsewhere).
 """
@@ -90,7 +91,27 @@ def where_looped(looped: Callable, always: Callable, *args):
     lowered, so one traced program serves every platform)."""
     if not LOOPED_PLATFORMS:
         return always(*args)
+    only = _only_backends()
+    if only is not None and only <= set(LOOPED_PLATFORMS):
+        return looped(*args)
+    if only is not None and not only & set(LOOPED_PLATFORMS):
+        return always(*args)
     return jax.lax.platform_dependent(*args, default=always, **{platform: looped for platform in LOOPED_PLATFORMS})
+
+
+def _only_backends():
+    """The platforms this process can lower programs for, or None before JAX's backends start.
+
+    When every backend is of one kind (a CPU-only host: the tests, most users' laptops), the
+    program can only ever be lowered for it, so `where_looped` traces the one branch that lowering
+    would pick. `platform_dependent` traces every branch, and the gates nest (an instruction's rare
+    work holds four more), so on a CPU-only host this halves an XO-CHIP machine's trace, for the
+    same lowered program."""
+    from jax._src import xla_bridge
+
+    if not xla_bridge.backends_are_initialized():
+        return None
+    return {backend.platform for backend in xla_bridge.backends().values()}
 
 
 def _per_platform(pred, fn, operands, inputs):

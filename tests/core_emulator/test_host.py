@@ -17,7 +17,7 @@ import jax, jax.numpy as jnp
 import octax_core
 if sys.argv[1] != "env":
     octax_core.limit_cpu_threads(int(sys.argv[1]))
-machine = octax_core.Machine("xochip", quirks="chip8", instructions_per_frame=11)
+machine = octax_core.Machine("chip8", quirks="chip8", instructions_per_frame=11)
 program = bytes([0xA2, 0x0A, 0xC0, 0x3F, 0xC1, 0x1F, 0xD0, 0x15, 0x12, 0x02, 0xF0, 0x90, 0x90, 0x90, 0xF0])
 state = jax.vmap(lambda k: machine.boot(program, k))(jax.random.split(jax.random.key(0), 8))
 state = jax.jit(jax.vmap(lambda s: machine.run_frames(s, 0, 30)))(state)

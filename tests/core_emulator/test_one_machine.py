@@ -250,6 +250,32 @@ def test_where_looped_picks_by_the_platform_the_program_is_lowered_for(monkeypat
     assert int(program()(jnp.int32(0))) == 2
 
 
+def test_on_a_host_with_one_kind_of_backend_only_its_branch_is_traced(monkeypatch):
+    """`platform_dependent` traces every branch, and gates nest, so an XO-CHIP machine's trace
+    took twice as long as needed on a CPU-only host; there the one branch lowering would pick is
+    traced alone. With other backends present (a GPU host) both are traced and lowering picks."""
+    from octax_core.emulator import gate
+
+    jax.devices()  # backends started, as before any real trace
+    traced = []
+
+    def which(name):
+        return lambda x: (traced.append(name), x + 1)[1]
+
+    jaxpr = jax.make_jaxpr(lambda x: gate.where_looped(which("looped"), which("always"), x))(jnp.int32(0))
+    cpu_only = {d.platform for d in jax.devices()} == {"cpu"}
+    if cpu_only:
+        assert traced == ["looped"] and "platform_index" not in str(jaxpr)
+    monkeypatch.setattr(gate, "_only_backends", lambda: {"cpu", "cuda"})
+    traced.clear()
+    jaxpr = jax.make_jaxpr(lambda x: gate.where_looped(which("looped"), which("always"), x))(jnp.int32(0))
+    assert sorted(traced) == ["always", "looped"] and "platform_index" in str(jaxpr)
+    monkeypatch.setattr(gate, "_only_backends", lambda: {"cuda"})
+    traced.clear()
+    jax.make_jaxpr(lambda x: gate.where_looped(which("looped"), which("always"), x))(jnp.int32(0))
+    assert traced == ["always"]
+
+
 # SUPER-CHIP and XO-CHIP archive programs that draw in hires, scroll and switch modes
 GATED_PROGRAMS = ("sens8tion", "superOctoTrackXO",  # SUPER-CHIP, XO-CHIP; two more in make test-slow
                   pytest.param("sweetcopter", marks=pytest.mark.slow), pytest.param("OctoPartyMix", marks=pytest.mark.slow))
@@ -317,19 +343,24 @@ def test_the_rare_work_crosses_into_its_gate_as_one_word():
             np.testing.assert_array_equal(getattr(unpacked, name), getattr(rare, name), err_msg=f"{field}: {name}")
 
 
-def test_an_instruction_has_a_gate_for_its_memory_write_and_one_for_its_rare_work():
+@pytest.mark.parametrize("backends", [{"cpu", "cuda"}, {"cpu"}])
+def test_an_instruction_has_a_gate_for_its_memory_write_and_one_for_its_rare_work(backends, monkeypatch):
     """Every platform's memory write is gated (few instructions write); SUPER-CHIP and XO-CHIP's
     rare work (scrolls, hires clears, plane 2, the grid's sprite) is one more gate at the
     instruction's top level, with its parts inside it. (A gate per part cost each batch a loop,
-    a predicate and their inputs on every instruction.)"""
+    a predicate and their inputs on every instruction.) Traced on a host with a GPU, each gate is
+    `platform_dependent` (a cond) over the loop; on a CPU-only host, the loop alone."""
+    from octax_core.emulator import gate
+
+    monkeypatch.setattr(gate, "_only_backends", lambda: backends)
+    gate_form, other = ("cond", "while") if len(backends) > 1 else ("while", "cond")
     for name, gates in (("chip8", 1), ("schip", 2), ("xochip", 2)):
         machine = octax_core.Machine(name)
         states = jax.vmap(lambda k: machine.boot(b"\x12\x00", k))(jax.random.split(jax.random.key(0), 4))
         instruction = jax.make_jaxpr(jax.vmap(lambda s, k: cpu.execute(machine.platform, machine.quirks, s, k)[0]))
         eqns = instruction(states, jnp.zeros(4, jnp.uint32)).jaxpr.eqns
-        # `gate.when_any` under vmap: one batch reduction, then `platform_dependent` (a cond) over the loop
-        assert sum(e.primitive.name == "cond" for e in eqns) == gates, name
-        assert not any(e.primitive.name == "while" for e in eqns), name
+        assert sum(e.primitive.name == gate_form for e in eqns) == gates, name
+        assert not any(e.primitive.name == other for e in eqns), name
 
 
 def _loop_bodies(hlo_text: str) -> dict[str, str]:
