@@ -17,6 +17,7 @@ imported inside the commands. This module only wires them up and reports errors.
     octax-gym roms import PATH [--dest DIR]   the same from a folder, zip or wheel on disk
     octax-gym dataset collect GAME --dataset-id ID --steps N [--envs K]   a Minari dataset (docs/datasets.md)
     octax-gym play GAME|ROM [--agent PATH] [--record ID] [--port N]   play in the browser (docs/play.md)
+    octax-gym train ppo|pqn [--games G,G] [--num-seeds S] [--preset paper]   agents in pure JAX (docs/training.md)
 
 GAME is a game id or Gymnasium id; where it says GAME|ROM a ROM file's path is taken too (all 16
 keys, no reward: `octax_gym.cli.common.game_or_rom`).
@@ -31,7 +32,7 @@ import sys
 import zipfile
 from typing import Optional, Sequence
 
-from octax_gym.cli import bench, dataset, games, octo, play, record, roms, trace
+from octax_gym.cli import bench, dataset, games, octo, play, record, roms, trace, train
 
 
 def main(argv: Optional[Sequence[str]] = None) -> int:
@@ -101,7 +102,7 @@ def build_parser() -> argparse.ArgumentParser:
         prog="octax-gym", description="CHIP-8, SUPER-CHIP and XO-CHIP games as reinforcement-learning environments.")
     parser.add_argument("--version", action=_Version, help="print the installed version and exit")
     commands = parser.add_subparsers(title="commands", metavar="COMMAND")
-    for module in (games, roms, record, bench, octo, trace, dataset, play):
+    for module in (games, roms, record, bench, octo, trace, dataset, play, train):
         module.add_commands(commands)
     return parser
 

@@ -1,0 +1,166 @@
+"""`octax-gym train ALGO`: the package's trainer (`octax_gym.train`) from the shell (docs/training.md).
+
+    octax-gym train ppo --games Airplane,Deep8 --num-seeds 2 --out-dir runs/ppo   # 4 agents, one program
+    octax-gym train pqn --game Brix --seed 3 --total-steps 1000000
+    octax-gym train ppo --preset paper --games octax16 --num-seeds 3              # the paper's table, on a GPU
+    octax-gym train ppo --resume runs/ppo                                           # a run cut short, continued
+
+Settings start from a preset (`--preset cpu`, the default, or `paper`) and each flag given
+overrides one. A setting no run can use, or one of another algorithm, is refused with its name.
+flax and optax (the train extra) are imported only when the command runs.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+from pathlib import Path
+
+TRAIN_HINT = "pip install 'octax-gym[train]'"
+ALGORITHMS = ("ppo", "pqn")
+PPO_ONLY = ("gae_lambda", "clip_eps", "clip_value_loss", "vf_coef", "ent_coef")
+PQN_ONLY = ("q_lambda", "epsilon_start", "epsilon_finish", "epsilon_fraction", "eval_epsilon")
+ENV_FLAGS = {"max_episode_steps": int, "frames_per_step": int, "repeat_action_probability": float, "noop_max": int}
+SETTINGS = {  # flag -> (type, help); each a TrainConfig field
+    "seed": (int, "the first seed: seeds S..S+N-1 each train one agent per game"),
+    "num_seeds": (int, "seeds per game (agents: games x seeds, one program)"),
+    "total_steps": (int, "env steps per agent (rounded down to whole updates)"),
+    "num_envs": (int, "training envs per agent"),
+    "num_steps": (int, "rollout length per env and update"),
+    "update_epochs": (int, "passes over each rollout"),
+    "num_minibatches": (int, "minibatches per epoch (num_envs * num_steps must divide)"),
+    "learning_rate": (float, "Adam step size"),
+    "gamma": (float, "discount"),
+    "max_grad_norm": (float, "global gradient-norm clip"),
+    "eval_every": (int, "env steps per agent between evaluations (and at both ends); 0: both ends only"),
+    "eval_envs": (int, "evaluation episodes per agent and policy (greedy and sampled)"),
+    "eval_max_steps": (int, "step cap of an evaluation (default: the game's episode cap)"),
+    "eval_noop_max": (int, "evaluation episodes start after 0..N no-ops (default 30: distinct episodes)"),
+    "checkpoint_every": (int, "updates between resumable checkpoints in OUT/resume (0: none)"),
+    "gae_lambda": (float, "PPO: GAE lambda"),
+    "clip_eps": (float, "PPO: ratio (and value) clip"),
+    "vf_coef": (float, "PPO: value loss weight"),
+    "ent_coef": (float, "PPO: entropy bonus weight"),
+    "q_lambda": (float, "PQN: lambda of the Q(lambda) returns"),
+    "epsilon_start": (float, "PQN: exploration rate of the first rollout"),
+    "epsilon_finish": (float, "PQN: exploration rate after the decay"),
+    "epsilon_fraction": (float, "PQN: fraction of the steps over which epsilon decays"),
+    "eval_epsilon": (float, "PQN: exploration rate of the sampled evaluation"),
+}
+
+
+def add_commands(commands: argparse._SubParsersAction) -> None:
+    train = commands.add_parser(
+        "train", help="train PPO or PQN agents in pure JAX: many games x seeds in one program",
+        description="Trains one agent per game and seed (not one agent for all games) in one jitted program, "
+                    "writing OUT/progress.csv (a row per game, seed and evaluation), OUT/learning_curve.png, "
+                    "OUT/agents/<game>-seed<s>.msgpack and OUT/summary.json. Needs the train extra: "
+                    + TRAIN_HINT + ". See docs/training.md.")
+    train.add_argument("algorithm", choices=ALGORITHMS, metavar="ALGO", help="ppo or pqn")
+    train.add_argument("--games", "--game", dest="games", metavar="G[,G...]",
+                       help="game ids, comma-separated, or octax16 (the paper's 16); default Brix")
+    train.add_argument("--preset", default="cpu", metavar="NAME",
+                       help="starting settings: cpu (64 envs, 655,360 steps; the default) or paper (512 envs x 32 "
+                            "steps, 4 x 32 minibatches, Adam 5e-4, 5M steps an agent)")
+    for name, (kind, text) in SETTINGS.items():
+        train.add_argument("--" + name.replace("_", "-"), type=kind, default=None, help=text)
+    train.add_argument("--anneal-lr", action=argparse.BooleanOptionalAction, default=None,
+                       help="decay the learning rate linearly to 0 (the paper: constant)")
+    train.add_argument("--clip-value-loss", action=argparse.BooleanOptionalAction, default=None,
+                       help="PPO: clip the value loss as CleanRL's Atari PPO does (default on)")
+    for name, kind in ENV_FLAGS.items():
+        train.add_argument("--" + name.replace("_", "-"), type=kind, default=None,
+                           help="an env option for every game (octax_core.make); default: the game's")
+    train.add_argument("--devices", default=None, metavar="all",
+                       help="all: every agent's envs split over every device (data-parallel); default one device")
+    train.add_argument("--agent-map", default=None, choices=("auto", "vmap", "map"),
+                       help="how agents share the program: vmap (batched, for a GPU), map (one after another: "
+                            "bit for bit a lone run's), auto (map on a CPU, vmap elsewhere; the default)")
+    train.add_argument("--out-dir", type=Path, default=None, metavar="OUT",
+                       help="where the run writes (default runs/<algo>-<games>-s<seed>)")
+    train.add_argument("--resume", type=Path, default=None, metavar="OUT",
+                       help="continue the run in OUT (made with --checkpoint-every) from its last checkpoint, "
+                            "with OUT/config.json; no other setting may be given")
+    train.add_argument("--no-progress", action="store_true", help="no progress bar")
+    train.set_defaults(func=_cmd_train)
+
+
+def config_from_args(args: argparse.Namespace):
+    """The checked `TrainConfig` the flags ask for (the preset, then each flag given).
+
+    Raises:
+        ValueError: a bad value, or a setting of the other algorithm (named).
+        ImportError: the train extra is missing.
+    """
+    _import_train()
+    from octax_gym.train import preset, resolve_games
+
+    given = {name: getattr(args, name) for name in (*SETTINGS, "anneal_lr", "clip_value_loss")
+             if getattr(args, name) is not None}
+    other = PQN_ONLY if args.algorithm == "ppo" else PPO_ONLY
+    if wrong := [name for name in given if name in other]:
+        flags = ", ".join("--" + n.replace("_", "-") for n in wrong)
+        raise ValueError(f"{flags}: not a setting of {args.algorithm} (they belong to "
+                         f"{'pqn' if args.algorithm == 'ppo' else 'ppo'})")
+    if args.games is not None:
+        given["games"] = resolve_games(args.games)
+    for name in ("devices", "agent_map"):
+        if getattr(args, name) is not None:
+            given[name] = getattr(args, name)
+    overrides = tuple((name, getattr(args, name)) for name in ENV_FLAGS if getattr(args, name) is not None)
+    if overrides:
+        given["env_overrides"] = overrides
+    return preset(args.preset, args.algorithm, **given)
+
+
+def _cmd_train(args: argparse.Namespace) -> int:
+    if args.resume is not None:
+        config, out_dir = _resumed(args)
+    else:
+        config = config_from_args(args)
+        out_dir = args.out_dir or Path("runs") / _run_name(config)
+    from octax_gym.train import train
+
+    print(f"{config.algorithm} on {', '.join(config.game_ids)} x seeds {config.seeds} -> {out_dir}")
+    train(config, out_dir, progress=not args.no_progress, resume=args.resume is not None)
+    print(f"wrote {out_dir / 'progress.csv'}, {out_dir / 'learning_curve.png'} and {out_dir / 'agents'}/")
+    return 0
+
+
+def _resumed(args: argparse.Namespace):
+    """The config of the run in `--resume OUT` (its config.json); refuses other settings."""
+    defaults = {"games": None, "preset": "cpu", "devices": None, "agent_map": None, "out_dir": None, "anneal_lr": None,
+                "clip_value_loss": None, **{n: None for n in (*SETTINGS, *ENV_FLAGS)}}
+    if given := [name for name, default in defaults.items() if getattr(args, name) != default]:
+        raise ValueError(f"--resume takes the run's own settings (OUT/config.json); drop "
+                         f"{', '.join('--' + n.replace('_', '-') for n in given)}")
+    _import_train()
+    import dataclasses
+
+    from octax_gym.train import TrainConfig
+
+    path = args.resume / "config.json"
+    if not path.is_file():
+        raise FileNotFoundError(f"--resume: no config.json in {args.resume} (not the folder of an octax-gym train run)")
+    saved = json.loads(path.read_text())
+    fields = {field.name for field in dataclasses.fields(TrainConfig)}
+    values = {k: v for k, v in saved.items() if k in fields}
+    values["games"] = tuple(values["games"])
+    values["env_overrides"] = tuple(tuple(pair) for pair in values.get("env_overrides", ()))
+    if values["algorithm"] != args.algorithm:
+        raise ValueError(f"--resume: {args.resume} is a {values['algorithm']} run, not {args.algorithm}")
+    return TrainConfig(**values).check(), args.resume
+
+
+def _run_name(config) -> str:
+    from octax_core.env.mix import MIXES
+
+    games = next((name for name, mix in MIXES.items() if tuple(config.game_ids) == mix), "-".join(config.game_ids))
+    return f"{config.algorithm}-{games}-s{config.seed}" + (f"-n{config.num_seeds}" if config.num_seeds > 1 else "")
+
+
+def _import_train() -> None:
+    try:
+        import octax_gym.train  # noqa: F401
+    except ImportError as exc:
+        raise ImportError(f"octax-gym train needs the train extra: {TRAIN_HINT} ({exc})") from exc

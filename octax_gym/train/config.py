@@ -1,0 +1,165 @@
+"""What a training run depends on, in one frozen dataclass (`TrainConfig`), checked once.
+
+Every field is a setting of the command line (`octax-gym train`, one flag per field) and is written
+to the run's config.json, so a run can be repeated or resumed from its folder alone. The
+algorithm's own settings (PPO's clip, PQN's lambda) are fields too: one flat record reads and
+resumes more simply than nested ones, and `check` refuses a setting that does nothing.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from typing import Any, Optional, Union
+
+from octax_core.env.games import GameSpec
+from octax_core.env.mix import MIXES
+
+ALGORITHMS = ("ppo", "pqn")
+DEVICES = ("", "all")
+AGENT_MAPS = ("auto", "vmap", "map")
+ENV_FLAGS = {"max_episode_steps": int, "frames_per_step": int, "repeat_action_probability": float,
+             "noop_max": int}  # octax_core.make options a run may override (for every game alike)
+
+
+@dataclasses.dataclass(frozen=True)
+class TrainConfig:
+    """Settings of one run of G games x S seeds; defaults are the paper's PPO (`presets.PAPER`).
+
+    `games` and `seed`..`seed + num_seeds - 1` make G x S independent agents, trained at once;
+    steps, envs and evaluations are per agent.
+    """
+
+    algorithm: str = "ppo"
+    games: tuple = ("Brix",)  # game ids (or GameSpecs, from Python); "octax16" expands to the paper's 16
+    seed: int = 0
+    num_seeds: int = 1
+    total_steps: int = 5_000_000  # env steps per agent
+    num_envs: int = 512  # training envs per agent
+    num_steps: int = 32  # rollout length per env and update
+    update_epochs: int = 4
+    num_minibatches: int = 32
+    learning_rate: float = 5e-4
+    anneal_lr: bool = False  # the paper names no schedule; its code passes a constant rate to Adam
+    gamma: float = 0.99
+    max_grad_norm: float = 0.5
+    eval_every: int = 131_072  # env steps per agent between evaluations; 0: at the start and the end only
+    eval_envs: int = 128  # evaluation episodes per agent and policy (one per env)
+    eval_max_steps: Optional[int] = None  # step cap per evaluation; None: the game's max_episode_steps
+    eval_noop_max: int = 30  # evaluation episodes start after 0..30 no-ops (the ALE protocol), see evaluate.py
+    checkpoint_every: int = 0  # updates between resumable checkpoints; 0: none
+    devices: str = ""  # "": one device; "all": every agent's envs split over every device
+    agent_map: str = "auto"  # how agents share the program: vmap, map (one after another), auto (many.py)
+    env_overrides: tuple = ()  # ((name, value), ...) of ENV_FLAGS, for every game
+    # PPO's
+    gae_lambda: float = 0.95
+    clip_eps: float = 0.2
+    clip_value_loss: bool = True  # CleanRL's Atari PPO and the paper's Rejax-based code clip it
+    vf_coef: float = 0.5
+    ent_coef: float = 0.01
+    # PQN's
+    q_lambda: float = 0.9
+    epsilon_start: float = 1.0
+    epsilon_finish: float = 0.05
+    epsilon_fraction: float = 0.1  # of total_steps, over which epsilon decays linearly
+    eval_epsilon: float = 0.005  # the sampled evaluation of PQN: epsilon-greedy (the paper's code)
+
+    @property
+    def batch_size(self) -> int:
+        return self.num_envs * self.num_steps
+
+    @property
+    def num_updates(self) -> int:
+        return max(1, self.total_steps // self.batch_size)
+
+    @property
+    def seeds(self) -> list[int]:
+        return [self.seed + i for i in range(self.num_seeds)]
+
+    @property
+    def game_ids(self) -> list[str]:
+        return [game.id if isinstance(game, GameSpec) else game for game in self.games]
+
+    @property
+    def agents(self) -> list[tuple[str, int]]:
+        """(game, seed) of each agent, in the order of the agent axis: game-major."""
+        return [(game, seed) for game in self.game_ids for seed in self.seeds]
+
+    def learning_rate_at(self, update: int) -> float:
+        """Adam's rate during update `update` (from 0): constant, or decaying linearly to 0 with `anneal_lr`."""
+        if not self.anneal_lr:
+            return self.learning_rate
+        return self.learning_rate * max(0.0, 1.0 - update / self.num_updates)
+
+    def epsilon(self, update: Any) -> Any:
+        """PQN's exploration rate in update `update`: linear in the env steps done before it, from
+        epsilon_start to epsilon_finish at epsilon_fraction of the run, then constant."""
+        import jax.numpy as jnp
+
+        decay_steps = max(1.0, self.epsilon_fraction * self.num_updates * self.batch_size)
+        progress = jnp.minimum(1.0, jnp.asarray(update, jnp.float32) * self.batch_size / decay_steps)
+        return self.epsilon_start + (self.epsilon_finish - self.epsilon_start) * progress
+
+    def check(self) -> "TrainConfig":
+        """Raises ValueError naming the first setting no run can use; returns the config."""
+        _choice("algorithm", self.algorithm, ALGORITHMS)
+        _choice("devices", self.devices, DEVICES)
+        _choice("agent_map", self.agent_map, AGENT_MAPS)
+        if not self.games:
+            raise ValueError("games must name at least one game (comma-separated ids, or octax16)")
+        if len(set(self.game_ids)) != len(self.game_ids):
+            raise ValueError(f"games names a game twice: {', '.join(self.game_ids)}")
+        for name in ("num_seeds", "num_envs", "num_steps", "update_epochs", "num_minibatches", "eval_envs",
+                     "total_steps"):
+            _at_least(name, getattr(self, name), 1)
+        for name in ("seed", "eval_every", "checkpoint_every", "eval_noop_max"):
+            _at_least(name, getattr(self, name), 0)
+        if self.eval_max_steps is not None:
+            _at_least("eval_max_steps", self.eval_max_steps, 1)
+        if self.batch_size % self.num_minibatches:
+            raise ValueError(f"num_envs * num_steps = {self.batch_size} is not divisible by "
+                             f"num_minibatches = {self.num_minibatches}")
+        if self.total_steps < self.batch_size:
+            raise ValueError(f"total_steps = {self.total_steps} is less than one update "
+                             f"(num_envs * num_steps = {self.batch_size})")
+        for name in ("learning_rate", "max_grad_norm"):
+            if not getattr(self, name) > 0:
+                raise ValueError(f"{name} must be > 0, got {getattr(self, name)}")
+        for name in ("gamma", "gae_lambda", "q_lambda", "epsilon_start", "epsilon_finish", "epsilon_fraction",
+                     "eval_epsilon"):
+            if not 0 <= getattr(self, name) <= 1:
+                raise ValueError(f"{name} must be in [0, 1], got {getattr(self, name)}")
+        for name, value in self.env_overrides:
+            _choice("env override", name, tuple(ENV_FLAGS))
+        return self
+
+
+def resolve_games(games: Union[str, tuple, list]) -> tuple:
+    """Game ids from a comma-separated string or a list; a named mix ("octax16", `octax_core`'s
+    `MIXES`: the paper's 16 games) expands to its games. Gymnasium ids and any-case names are
+    taken (`octax_gym.game_names`).
+
+    Raises:
+        UnknownOptionError: a name that is no registered game (the message lists the valid ones).
+    """
+    from octax_gym.game_names import resolve_spec
+
+    names = [g.strip() for g in games.split(",")] if isinstance(games, str) else list(games)
+    out: list = []
+    for name in names:
+        if isinstance(name, GameSpec):
+            out.append(name)
+        elif name in MIXES:
+            out.extend(MIXES[name])
+        elif name:
+            out.append(resolve_spec(name).id)
+    return tuple(out)
+
+
+def _choice(name: str, value, choices) -> None:
+    if value not in choices:
+        raise ValueError(f"{name} must be one of {', '.join(repr(c) for c in choices)}, got {value!r}")
+
+
+def _at_least(name: str, value, minimum: int) -> None:
+    if isinstance(value, bool) or not isinstance(value, int) or value < minimum:
+        raise ValueError(f"{name} must be an int >= {minimum}, got {value!r}")

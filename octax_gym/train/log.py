@@ -1,0 +1,102 @@
+"""progress.csv: one row per (game, seed, evaluation), appended as the run goes.
+
+Columns: the agent (`game`, `seed`), where the run is (`step` per agent, `update`, `wall_s`,
+`env_steps_per_s` of all agents together, compile and evaluation excluded), the evaluation
+(`eval_mean_return` is the sampled policy's, the paper's protocol; `eval_greedy_*` and
+`eval_sampled_*` both, with their std over episodes; `eval_ended_frac`), the random baseline and
+the normalized score from the committed table (`octax_gym.scores`: never re-measured here), the
+training episodes finished since the last evaluation, and the algorithm's metrics averaged over
+those updates. A resumed run rewrites the file with the rows up to its checkpoint.
+"""
+
+from __future__ import annotations
+
+import csv
+import math
+from pathlib import Path
+from typing import Optional, Sequence
+
+import numpy as np
+
+from octax_gym import scores
+
+COMMON_COLUMNS = ("game", "seed", "step", "update", "wall_s", "env_steps_per_s", "eval_mean_return", "eval_std",
+                  "eval_greedy_return", "eval_greedy_std", "eval_sampled_return", "eval_sampled_std",
+                  "eval_ended_frac", "random_mean_return", "normalized_score", "train_episode_return",
+                  "train_episodes")
+
+
+def baseline(game: str) -> tuple[float, Optional[float]]:
+    """The game's random mean return and reference from `octax_gym/data/scores.json`; (nan, None)
+    for a game the table does not list (a GameSpec of your own)."""
+    row = scores.score_table().get(game)
+    return (math.nan, None) if row is None else (row.random_mean, row.reference)
+
+
+def normalized(game: str, value: float) -> float:
+    """(value - random) / (reference - random), or nan where the game has no reference."""
+    random_mean, reference = baseline(game)
+    if reference is None or math.isnan(random_mean):
+        return math.nan
+    return float(scores.normalized_score(game, value))
+
+
+class ProgressLog:
+    """Appends the rows of each evaluation to `out_dir/progress.csv`."""
+
+    def __init__(self, out_dir: Path, agents: Sequence[tuple[str, int]], metric_names: Sequence[str],
+                 keep_until: Optional[int] = None, write: bool = True):
+        """A new log; or, with `keep_until` (a resumed run's update), the existing rows up to that
+        update, rewritten without the rows a killed run logged after its checkpoint."""
+        self.csv_path = Path(out_dir) / "progress.csv"
+        self.agents, self.metric_names, self.rows, self.write = list(agents), tuple(metric_names), [], write
+        self.columns = COMMON_COLUMNS + self.metric_names
+        if not write:
+            return
+        if keep_until is not None:
+            with open(self.csv_path, newline="") as f:
+                self.rows = [{k: _cell(k, v) for k, v in row.items()} for row in csv.DictReader(f)
+                             if int(row["update"]) <= keep_until]
+        with open(self.csv_path, "w", newline="") as f:
+            csv.writer(f).writerow(self.columns)
+            csv.DictWriter(f, self.columns).writerows(self.rows)
+
+    def add(self, update: int, step: int, wall_s: float, train_s: float, evaluation, totals: dict,
+            host_metrics: dict) -> list[dict]:
+        """Rows for one evaluation: `evaluation` an `Evaluation` of (num_agents, eval_envs) arrays;
+        `totals` each metric's (num_agents,) sum over the updates since the last evaluation."""
+        greedy, sampled = np.asarray(evaluation.greedy_return), np.asarray(evaluation.sampled_return)
+        ended = np.concatenate([np.asarray(evaluation.greedy_ended), np.asarray(evaluation.sampled_ended)], axis=1)
+        n = totals.get("updates", 0)
+        rows = []
+        for i, (game, seed) in enumerate(self.agents):
+            episodes = float(totals["finished_episodes"][i]) if n else 0.0
+            mean = float(sampled[i].mean())
+            row = {"game": game, "seed": seed, "step": step, "update": update, "wall_s": round(wall_s, 2),
+                   "env_steps_per_s": round(step * len(self.agents) / train_s, 1) if train_s else math.nan,
+                   "eval_mean_return": mean, "eval_std": float(sampled[i].std()),
+                   "eval_greedy_return": float(greedy[i].mean()), "eval_greedy_std": float(greedy[i].std()),
+                   "eval_sampled_return": mean, "eval_sampled_std": float(sampled[i].std()),
+                   "eval_ended_frac": float(ended[i].mean()), "random_mean_return": baseline(game)[0],
+                   "normalized_score": normalized(game, mean),
+                   "train_episode_return": (float(totals["finished_return_sum"][i]) / episodes
+                                            if episodes else math.nan),
+                   "train_episodes": int(episodes)}
+            for name in self.metric_names:
+                row[name] = float(totals[name][i]) / n if n and name in totals else host_metrics.get(name, math.nan)
+            rows.append(row)
+        self.rows.extend(rows)
+        if self.write:
+            with open(self.csv_path, "a", newline="") as f:
+                csv.DictWriter(f, self.columns).writerows(rows)
+        return rows
+
+
+def _cell(column: str, text: str):
+    """A CSV cell back as the value it was written from."""
+    if column == "game":
+        return text
+    try:
+        return int(text)
+    except ValueError:
+        return float(text)

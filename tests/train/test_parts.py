@@ -1,0 +1,104 @@
+"""octax_gym.train's parts on their own: the network's shapes and convolution, the masks on a game's
+actions (never an illegal sample, argmax or exploration; a finite entropy), GAE and the Q(lambda)
+returns against plain loops, and the agent map's exactness (gradients exact only one agent at a
+time: why `agent_map="auto"` maps agents one by one on a CPU)."""
+
+from __future__ import annotations
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+import pytest
+
+pytest.importorskip("flax")
+from octax_gym.train import many, ppo, pqn  # noqa: E402
+from octax_gym.train.networks import (ACTIONS, ActorCritic, ConvTorso, QNetwork, conv_valid, legal_actions,  # noqa: E402
+                                      masked, network_for)
+
+
+def test_network_shapes_and_a_fixed_width():
+    obs = jnp.zeros((5, 4, 32, 64), jnp.uint8)
+    features, _ = ConvTorso().init_with_output(jax.random.key(0), obs)
+    assert features.shape == (5, 1024)
+    (logits, value), params = ActorCritic().init_with_output(jax.random.key(0), obs)
+    assert logits.shape == (5, ACTIONS) == (5, 17) and value.shape == (5,)
+    kernels = [params["params"]["ConvTorso_0"][f"Conv_{i}"]["kernel"].shape for i in range(3)]
+    assert kernels == [(8, 4, 4, 32), (4, 4, 32, 64), (3, 3, 64, 64)]
+    q_params = QNetwork().init(jax.random.key(0), obs)
+    assert isinstance(network_for(q_params), QNetwork) and isinstance(network_for(params), ActorCritic)
+    assert network_for(ActorCritic(3).init(jax.random.key(0), obs)).num_actions == 3  # an examples' file
+
+
+@pytest.mark.parametrize("x_shape, k_shape, strides", [
+    ((2, 64, 32, 4), (8, 4, 4, 32), (4, 2)), ((2, 15, 15, 32), (4, 4, 32, 64), (2, 2))])
+def test_conv_valid_equals_lax_conv(x_shape, k_shape, strides):
+    x = jax.random.normal(jax.random.key(1), x_shape)
+    kernel = jax.random.normal(jax.random.key(2), k_shape)
+    expected = jax.lax.conv_general_dilated(x, kernel, strides, "VALID", dimension_numbers=("NHWC", "HWIO", "NHWC"))
+    np.testing.assert_allclose(conv_valid(x, kernel, strides), expected, rtol=1e-4, atol=1e-3)
+
+
+def test_masked_actions_are_never_chosen_and_cost_no_entropy():
+    legal = legal_actions(3)
+    logits = jnp.zeros((4000, ACTIONS)).at[:, 10].set(5.0)  # an illegal favourite
+    sample = jax.random.categorical(jax.random.key(0), masked(logits, legal))
+    assert int(sample.max()) < 3 and set(np.unique(sample).tolist()) == {0, 1, 2}
+    assert int(jnp.argmax(masked(logits, legal), axis=1).max()) < 3
+    log_probs = jax.nn.log_softmax(masked(logits, legal))
+    entropy = -(jnp.exp(log_probs) * log_probs).sum(-1)
+    np.testing.assert_allclose(entropy, np.log(3), rtol=1e-6)
+    explored = pqn.epsilon_greedy(logits, jax.random.key(1), 1.0, legal)
+    assert set(np.unique(explored).tolist()) == {0, 1, 2}
+
+
+def test_gae_matches_a_loop():
+    rng = np.random.default_rng(0)
+    steps, envs, gamma, lam = 6, 3, 0.9, 0.8
+    reward, value = rng.normal(size=(steps, envs)), rng.normal(size=(steps, envs))
+    done = rng.random((steps, envs)) < 0.3
+    last_value = rng.normal(size=envs)
+    advantages, targets = ppo.gae(jnp.asarray(reward, jnp.float32), jnp.asarray(done), jnp.asarray(value, jnp.float32),
+                                  jnp.asarray(last_value, jnp.float32), gamma, lam)
+    expected, running = np.zeros((steps, envs)), np.zeros(envs)
+    for t in reversed(range(steps)):
+        next_value = last_value if t == steps - 1 else value[t + 1]
+        delta = reward[t] + gamma * next_value * ~done[t] - value[t]
+        running = delta + gamma * lam * ~done[t] * running
+        expected[t] = running
+    np.testing.assert_allclose(advantages, expected, rtol=1e-5, atol=1e-5)
+    np.testing.assert_allclose(targets, expected + value, rtol=1e-5, atol=1e-5)
+
+
+def test_q_lambda_targets_match_a_loop():
+    rng = np.random.default_rng(1)
+    steps, envs, gamma, lam = 5, 2, 0.9, 0.7
+    reward, q_max = rng.normal(size=(steps, envs)), rng.normal(size=(steps, envs))
+    done = rng.random((steps, envs)) < 0.3
+    last_q = rng.normal(size=envs)
+    targets = pqn.q_lambda_targets(*(jnp.asarray(a, jnp.float32) for a in (reward,)), jnp.asarray(done),
+                                   jnp.asarray(q_max, jnp.float32), jnp.asarray(last_q, jnp.float32), gamma, lam)
+    expected, next_return, next_q = np.zeros((steps, envs)), last_q, last_q
+    for t in reversed(range(steps)):
+        expected[t] = reward[t] + gamma * ~done[t] * (lam * next_return + (1 - lam) * next_q)
+        next_return, next_q = expected[t], q_max[t]
+    np.testing.assert_allclose(targets, expected, rtol=1e-5, atol=1e-5)
+
+
+def _bits_of_agent(fn, params, obs, agent_map):
+    both = jax.jit(many.over_agents(fn, 4, agent_map))(params, obs)
+    lone = jax.jit(fn)(jax.tree.map(lambda x: x[1], params), obs[1])
+    return all(np.array_equal(np.asarray(a)[1], np.asarray(b)) for a, b in zip(jax.tree.leaves(both),
+                                                                                jax.tree.leaves(lone)))
+
+
+def test_agent_map_one_by_one_is_bit_exact_where_vmap_is_not():
+    network = QNetwork()
+    obs = (jax.random.uniform(jax.random.key(0), (4, 64, 4, 32, 64)) < 0.2).astype(jnp.uint8)
+    params = jax.tree.map(lambda *x: jnp.stack(x), *[network.init(k, obs[0, :1]) for k in jax.random.split(
+        jax.random.key(1), 4)])
+
+    def grad(p, o):
+        return jax.grad(lambda p: jax.nn.log_softmax(network.apply(p, o)).mean())(p)
+
+    assert _bits_of_agent(grad, params, obs, "map")
+    assert not _bits_of_agent(grad, params, obs, "vmap")  # if this ever holds, "vmap" could be the CPU default
