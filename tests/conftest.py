@@ -26,9 +26,11 @@ os.environ.setdefault("OCTAX_ROM_DIR", str(SHARED / "roms" / "octax"))
 # run after run, so a second run reads them from disk. The cache lives in the clone (.cache/, git
 # ignores it); the environment variables reach the CLI and example subprocesses the tests start.
 # A compiled program is keyed by its HLO, options and JAX version, so a stale entry is never used.
+# Every compile is kept, however short: a test's eager jnp ops (outside any jit) each compile a tiny
+# program of 10-50 ms, hundreds per process, and reading them back is cheaper than compiling them.
 _JAX_CACHE = os.environ.setdefault("JAX_COMPILATION_CACHE_DIR",
                                    str(Path(__file__).resolve().parent.parent / ".cache" / "jax"))
-os.environ.setdefault("JAX_PERSISTENT_CACHE_MIN_COMPILE_TIME_SECS", "0.1")
+os.environ.setdefault("JAX_PERSISTENT_CACHE_MIN_COMPILE_TIME_SECS", "0")
 jax.config.update("jax_compilation_cache_dir", _JAX_CACHE)
 jax.config.update("jax_persistent_cache_min_compile_time_secs",
                   float(os.environ["JAX_PERSISTENT_CACHE_MIN_COMPILE_TIME_SECS"]))
