@@ -1,21 +1,21 @@
-"""The pure-JAX examples' trained networks, run from their saved params without the examples.
+"""Trained JAX agents run from their saved params: the package's network (`octax_gym.train.networks`).
 
-`examples/train_jax_ppo.py`, `train_jax_pqn.py` and `train_jax_selfplay.py` save
-`flax.serialization.to_bytes` of `examples/jax_networks.py`'s `ActorCritic` or `QNetwork`
-(`params.msgpack`). Here those params are read back and the network's forward pass is computed in
-plain JAX from its parameter names (PQN's has a LayerNorm), so `octax-gym play --agent` and the
-dataset suite (`octax_gym.datasets.suite`) run trained agents with no import of the examples.
-Reading the msgpack needs flax (the `train` extra); nothing else here does.
+`octax-gym train` saves each agent as `OUT/agents/<game>-seed<s>.msgpack` (flax serialization of
+`{"params": ...}` of `ActorCritic` or `QNetwork`, 17 outputs: no-op and the 16 keys); older files
+of the examples (one output per action of their game) load too, and float16 copies (committed
+agents) are read back as float32. Here they are read and run by the same flax modules that trained
+them, so `octax-gym play --agent` and the dataset suite (`octax_gym.datasets.suite`) play exactly
+the trained network. Needs flax (the `train` extra).
 
-    params = load_params("runs/airplane/params.msgpack")
-    net = describe(params)                    # Network(kind="actor_critic", channels=4, num_actions=2)
-    act = sampling_policy(params, seed=0)     # numpy (B, 4, 32, 64) -> numpy (B,) actions
+    params = load_params("runs/ppo/agents/Airplane-seed0.msgpack")
+    net = describe(params)                    # Network(kind="actor_critic", channels=4, num_actions=17)
+    act = sampling_policy(params, seed=0, num_actions=2)   # numpy (B, 4, 32, 64) -> numpy (B,) actions
 """
 
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Callable, NamedTuple
+from typing import Callable, NamedTuple, Optional
 
 import jax
 import jax.numpy as jnp
@@ -23,18 +23,18 @@ import numpy as np
 
 
 class Network(NamedTuple):
-    """What a params file holds: its network, input planes and actions."""
+    """What a params file holds: its network, input planes and outputs."""
 
     kind: str  # "actor_critic" (PPO, self-play) or "q_network" (PQN)
     channels: int  # input planes: the frames (plus a player plane for self-play agents)
-    num_actions: int
+    num_actions: int  # the network's outputs; a game takes its first actions (no-op, then its keys)
 
 
 def load_params(path) -> dict:
-    """The params saved at `path` by the JAX examples, as nested dicts of JAX arrays.
+    """The params saved at `path` by `octax-gym train` (or the older examples), as float32 JAX arrays.
 
     Raises:
-        ImportError: flax is missing. ValueError: not params of the examples' networks.
+        ImportError: flax is missing. ValueError: not params of the package's networks.
     """
     path = Path(path)
     try:
@@ -44,43 +44,41 @@ def load_params(path) -> dict:
     try:
         params = flax.serialization.msgpack_restore(path.read_bytes())
         describe(params)
-    except Exception as exc:  # msgpack's and KeyError's: not the examples' params
-        raise ValueError(f"{path} is not params saved by the JAX examples (flax msgpack of ActorCritic or "
+    except Exception as exc:  # msgpack's and KeyError's: not a params file of ours
+        raise ValueError(f"{path} is not params saved by octax-gym train (flax msgpack of ActorCritic or "
                          f"QNetwork): {exc!r}") from None
-    return jax.tree.map(jnp.asarray, params)
+    return jax.tree.map(lambda x: jnp.asarray(x, jnp.float32) if np.asarray(x).dtype == np.float16 else jnp.asarray(x),
+                        params)
 
 
 def describe(params) -> Network:
-    p = params["params"]
-    kind = "q_network" if "LayerNorm_0" in p else "actor_critic"
-    return Network(kind, int(p["ConvTorso_0"]["Conv_0"]["kernel"].shape[2]), int(p["Dense_1"]["kernel"].shape[1]))
+    """The kind, input planes and outputs of saved params (read from their shapes)."""
+    from octax_gym.train.networks import QNetwork, network_for
+
+    network = network_for(params)
+    channels = int(params["params"]["ConvTorso_0"]["Conv_0"]["kernel"].shape[2])
+    return Network("q_network" if isinstance(network, QNetwork) else "actor_critic", channels, network.num_actions)
 
 
-def action_scores(params, obs: jax.Array) -> jax.Array:
-    """The policy's logits (ActorCritic) or Q-values (QNetwork), (B, num_actions), of uint8 (B, C, 32, 64)."""
-    return (q_values if "LayerNorm_0" in params["params"] else actor_critic_logits)(params, obs)
+def action_scores(params, obs: jax.Array, num_actions: Optional[int] = None) -> jax.Array:
+    """The policy's logits (ActorCritic) or Q-values (QNetwork), (B, outputs), of uint8 (B, C, 32, 64);
+    with `num_actions`, the actions past a game's own are masked (`networks.masked`)."""
+    from octax_gym.train.networks import legal_actions, masked, network_for, scores_of
+
+    scores = scores_of(network_for(params), params, obs)
+    if num_actions is None or num_actions == scores.shape[-1]:
+        return scores
+    return masked(scores, legal_actions(num_actions)[:scores.shape[-1]])
 
 
-def actor_critic_logits(params, obs):
-    """`ActorCritic.apply(params, obs)[0]` of examples/jax_networks.py."""
-    p = params["params"]
-    features = _torso(p["ConvTorso_0"], obs)
-    return _dense(p["Dense_1"], jax.nn.relu(_dense(p["Dense_0"], features)))
-
-
-def q_values(params, obs):
-    """`QNetwork.apply(params, obs)` of examples/jax_networks.py."""
-    p = params["params"]
-    hidden = _dense(p["Dense_0"], _torso(p["ConvTorso_0"], obs))
-    return _dense(p["Dense_1"], jax.nn.relu(_layer_norm(p["LayerNorm_0"], hidden)))
-
-
-def sampling_policy(params, seed: int) -> Callable[[np.ndarray], np.ndarray]:
+def sampling_policy(params, seed: int, num_actions: Optional[int] = None) -> Callable[[np.ndarray], np.ndarray]:
     """A batched policy for `collect_dataset`: actions sampled from the softmax of the network's
-    scores (the stochastic policy PPO trains and is evaluated with), from a key chain of `seed`
-    (call i folds i into it), so the same seed gives the same actions."""
+    scores over the game's `num_actions` actions (the stochastic policy PPO trains and is
+    evaluated with), from a key chain of `seed` (call i folds i into it): the same seed, the
+    same actions."""
     key = jax.random.key(seed)
-    draw = jax.jit(lambda params, key, obs: jax.random.categorical(key, action_scores(params, obs)).astype(jnp.int32))
+    draw = jax.jit(lambda params, key, obs: jax.random.categorical(
+        key, action_scores(params, obs, num_actions)).astype(jnp.int32))
     calls = iter(range(2 ** 31))
 
     def act(obs: np.ndarray) -> np.ndarray:
@@ -88,30 +86,3 @@ def sampling_policy(params, seed: int) -> Callable[[np.ndarray], np.ndarray]:
 
     act.__name__ = "ppo_policy"
     return act
-
-
-def _conv_valid(x, kernel, strides):
-    """`examples/jax_networks.conv_valid`: a VALID NHWC convolution as one matmul over slices."""
-    kh, kw, cin, cout = kernel.shape
-    (sh, sw), (h, w) = strides, x.shape[1:3]
-    oh, ow = (h - kh) // sh + 1, (w - kw) // sw + 1
-    patches = [x[:, i:i + sh * (oh - 1) + 1:sh, j:j + sw * (ow - 1) + 1:sw] for i in range(kh) for j in range(kw)]
-    return jnp.concatenate(patches, axis=-1) @ kernel.reshape(kh * kw * cin, cout)
-
-
-def _torso(p, obs):
-    x = jnp.transpose(obs, (0, 3, 2, 1)).astype(jnp.float32)
-    for i, strides in enumerate(((4, 2), (2, 2), (1, 1))):
-        conv = p[f"Conv_{i}"]
-        x = jax.nn.relu(_conv_valid(x, conv["kernel"], strides) + conv["bias"])
-    return x.reshape(x.shape[0], -1)
-
-
-def _dense(p, x):
-    return x @ p["kernel"] + p["bias"]
-
-
-def _layer_norm(p, x, eps=1e-6):
-    mean = x.mean(-1, keepdims=True)
-    var = ((x - mean) ** 2).mean(-1, keepdims=True)
-    return (x - mean) / jnp.sqrt(var + eps) * p["scale"] + p["bias"]

@@ -109,6 +109,13 @@ def pick_policies(run_dir) -> dict[str, PolicyCard]:
             "expert": card("expert", run_dir / "params.msgpack", final_step)}
 
 
+def _num_actions(game: str) -> int:
+    """The game's actions (no-op, then its keys): what a trainer's 17-wide agent is masked to."""
+    from octax_core import get_spec
+
+    return len(get_spec(game).action_keys) + 1
+
+
 def build_suite(runs_dir, games: Sequence[str] = GAMES, kinds: Sequence[str] = KINDS, *, steps: int = STEPS,
                 num_envs: int = ENVS, seed: int = 0, overwrite: bool = False, progress: bool = True) -> list:
     """Collects the suite's datasets (every game x kind asked for) from the training runs under
@@ -131,8 +138,8 @@ def build_suite(runs_dir, games: Sequence[str] = GAMES, kinds: Sequence[str] = K
         cards = pick_policies(Path(runs_dir) / game) if set(kinds) - {"random"} else {}
         for kind in kinds:
             card: Optional[PolicyCard] = cards.get(kind)
-            policy = "random" if card is None else jax_policy.sampling_policy(jax_policy.load_params(card.params_path),
-                                                                              seed)
+            policy = "random" if card is None else jax_policy.sampling_policy(
+                jax_policy.load_params(card.params_path), seed, num_actions=_num_actions(game))
             description = (f"octax/{game}-v0, {kind}: " + ("uniform random actions" if card is None else
                            f"{card.algorithm} after {card.steps_trained:,} steps (evaluation return "
                            f"{card.eval_return:.2f}; random {card.random_return:.2f}), actions sampled") +

@@ -2,10 +2,10 @@
 
 Two formats:
 
-* `*.msgpack`: the params the pure-JAX examples save (`examples/train_jax_ppo.py`,
-  `train_jax_pqn.py`, `train_jax_selfplay.py`: `flax.serialization.to_bytes` of
-  `examples/jax_networks.py`'s `ActorCritic` or `QNetwork`), run by `octax_gym.jax_policy` in
-  plain JAX, so the examples need not be importable; it plays greedily (the largest logit or Q-value). Needs flax (the `train` extra).
+* `*.msgpack`: the params `octax-gym train` saves (`OUT/agents/<game>-seed<s>.msgpack`:
+  `flax.serialization.to_bytes` of `octax_gym.train.networks`' `ActorCritic` or `QNetwork`; the
+  older examples' files too), run by `octax_gym.jax_policy` with the package's network; it plays
+  greedily (the largest logit or Q-value among the game's actions). Needs flax (the `train` extra).
 * `*.zip`: a Stable-Baselines3 model (`model.save(...)`: PPO, A2C or DQN over
   `octax_gym.sb3.OctaxCNNExtractor`), played with `policy.predict(obs, deterministic=True)` as the
   model's own `predict`. SB3's loader unpickles the zip, which runs any code stored in it, so the
@@ -56,10 +56,13 @@ def _jax_agent(path: Path, num_actions: int) -> Agent:
         params = jax_policy.load_params(path)
     except ImportError as exc:
         raise ImportError(f"--agent {exc}") from exc
+    from octax_gym.train.networks import ACTIONS  # flax is there: the params loaded
+
     network = jax_policy.describe(params)
-    if network.num_actions != num_actions:
+    if network.num_actions < num_actions or (network.num_actions != num_actions and network.num_actions != ACTIONS):
         raise ValueError(f"{path} plays {network.num_actions} actions; this game has {num_actions}")
-    greedy = jax.jit(lambda obs: jnp.argmax(jax_policy.action_scores(params, obs[None]), axis=-1)[0])
+    # A trainer's agent has an output per key (ACTIONS); the game takes its first `num_actions`.
+    greedy = jax.jit(lambda obs: jnp.argmax(jax_policy.action_scores(params, obs[None], num_actions), axis=-1)[0])
     return _fit_channels(lambda obs: int(greedy(jnp.asarray(obs))), network.channels)
 
 

@@ -15,7 +15,6 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from octax_gym.jax_policy import actor_critic_logits, q_values
 from octax_gym.play.agents import load_agent
 from octax_gym.play.session import Session
 
@@ -25,35 +24,48 @@ GAME = "Dodge"
 
 @pytest.fixture(scope="module")
 def networks():
-    pytest.importorskip("flax", reason="the JAX examples' networks need flax (the train extra)")
-    sys.path.insert(0, str(REPO / "examples"))
-    try:
-        import jax_networks
-    finally:
-        sys.path.remove(str(REPO / "examples"))
-    return jax_networks
+    pytest.importorskip("flax", reason="the trainer's networks need flax (the train extra)")
+    from octax_gym.train import networks
+    return networks
 
 
 @pytest.mark.parametrize("kind", ["ppo", "pqn"])
-def test_jax_params_play_as_the_examples_network(networks, kind, tmp_path):
+@pytest.mark.parametrize("width", [3, 17], ids=["examples-file", "trainer-file"])
+def test_jax_params_play_as_the_trainers_network(networks, kind, width, tmp_path):
     import flax.serialization
     import jax
 
-    network = networks.ActorCritic(3) if kind == "ppo" else networks.QNetwork(3)
+    from octax_gym.jax_policy import action_scores
+
+    network = networks.ActorCritic(width) if kind == "ppo" else networks.QNetwork(width)
     obs = jax.random.randint(jax.random.key(1), (3, 4, 32, 64), 0, 2).astype(np.uint8)
     params = network.init(jax.random.key(0), obs)
     path = tmp_path / "params.msgpack"
     path.write_bytes(flax.serialization.to_bytes(params))
-    ours = (actor_critic_logits if kind == "ppo" else q_values)(
-        flax.serialization.msgpack_restore(path.read_bytes()), obs)
+    ours = action_scores(flax.serialization.msgpack_restore(path.read_bytes()), obs)
     theirs = network.apply(params, obs)[0] if kind == "ppo" else network.apply(params, obs)
-    np.testing.assert_allclose(np.asarray(ours), np.asarray(theirs), rtol=1e-5, atol=1e-5)
-    agent = load_agent(path, 3)
-    assert [agent(np.asarray(o)) for o in obs] == list(np.asarray(theirs).argmax(-1))
+    np.testing.assert_array_equal(np.asarray(ours), np.asarray(theirs))
+    agent = load_agent(path, 3)  # a game of 3 actions: a 17-wide agent picks among its first 3
+    assert [agent(np.asarray(o)) for o in obs] == list(np.asarray(theirs)[:, :3].argmax(-1))
     # A one-player agent in a two-player seat gets the screens without the player plane.
     assert agent(np.concatenate([np.asarray(obs[0]), np.ones((1, 32, 64), np.uint8)])) == agent(np.asarray(obs[0]))
-    with pytest.raises(ValueError, match="plays 3 actions"):
-        load_agent(path, 5)
+    with pytest.raises(ValueError, match=f"plays {width} actions"):
+        load_agent(path, 5 if width == 3 else 18)
+
+
+def test_float16_params_play_as_their_float32_originals(networks, tmp_path):
+    import flax.serialization
+    import jax
+
+    network = networks.ActorCritic()
+    obs = jax.random.randint(jax.random.key(1), (8, 4, 32, 64), 0, 2).astype(np.uint8)
+    params = network.init(jax.random.key(0), obs)
+    half = tmp_path / "half.msgpack"
+    half.write_bytes(flax.serialization.to_bytes(jax.tree.map(lambda x: x.astype(np.float16), params)))
+    agent = load_agent(half, 4)
+    expected = np.asarray(network.apply(jax.tree.map(lambda x: x.astype(np.float16).astype(np.float32), params),
+                                        obs)[0])[:, :4].argmax(-1)
+    assert [agent(np.asarray(o)) for o in obs] == list(expected)
 
 
 def test_bad_agent_files(tmp_path):
