@@ -4,6 +4,7 @@
     octax-gym train pqn --game Brix --seed 3 --total-steps 1000000
     octax-gym train ppo --preset paper --games octax16 --num-seeds 3              # the paper's table, on a GPU
     octax-gym train ppo --resume runs/ppo                                           # a run cut short, continued
+    octax-gym train multitask --games Airplane,Brix,Deep8,Filter --num-envs 64       # one agent for all four
 
 Settings start from a preset (`--preset cpu`, the default, or `paper`) and each flag given
 overrides one. A setting no run can use, or one of another algorithm, is refused with its name.
@@ -17,9 +18,11 @@ import json
 from pathlib import Path
 
 TRAIN_HINT = "pip install 'octax-gym[train]'"
-ALGORITHMS = ("ppo", "pqn")
+ALGORITHMS = ("ppo", "pqn", "multitask")
 PPO_ONLY = ("gae_lambda", "clip_eps", "clip_value_loss", "vf_coef", "ent_coef")
 PQN_ONLY = ("q_lambda", "epsilon_start", "epsilon_finish", "epsilon_fraction", "eval_epsilon")
+MULTITASK_ONLY = ("game_input",)
+NOT_OF = {"ppo": PQN_ONLY + MULTITASK_ONLY, "pqn": PPO_ONLY + MULTITASK_ONLY, "multitask": PQN_ONLY}
 ENV_FLAGS = {"max_episode_steps": int, "frames_per_step": int, "repeat_action_probability": float, "noop_max": int}
 SETTINGS = {  # flag -> (type, help); each a TrainConfig field
     "seed": (int, "the first seed: seeds S..S+N-1 each train one agent per game"),
@@ -51,12 +54,13 @@ SETTINGS = {  # flag -> (type, help); each a TrainConfig field
 
 def add_commands(commands: argparse._SubParsersAction) -> None:
     train = commands.add_parser(
-        "train", help="train PPO or PQN agents in pure JAX: many games x seeds in one program",
+        "train", help="train PPO or PQN agents in pure JAX: many games x seeds in one program (or multi-task)",
         description="Trains one agent per game and seed (not one agent for all games) in one jitted program, "
+                    "(multitask: one PPO agent per seed for all the games, lane i playing game i mod G), "
                     "writing OUT/progress.csv (a row per game, seed and evaluation), OUT/learning_curve.png, "
                     "OUT/agents/<game>-seed<s>.msgpack and OUT/summary.json. Needs the train extra: "
                     + TRAIN_HINT + ". See docs/training.md.")
-    train.add_argument("algorithm", choices=ALGORITHMS, metavar="ALGO", help="ppo or pqn")
+    train.add_argument("algorithm", choices=ALGORITHMS, metavar="ALGO", help="ppo, pqn or multitask")
     train.add_argument("--games", "--game", dest="games", metavar="G[,G...]",
                        help="game ids, comma-separated, or octax16 (the paper's 16); default Brix")
     train.add_argument("--preset", default="cpu", metavar="NAME",
@@ -68,6 +72,9 @@ def add_commands(commands: argparse._SubParsersAction) -> None:
                        help="decay the learning rate linearly to 0 (the paper: constant)")
     train.add_argument("--clip-value-loss", action=argparse.BooleanOptionalAction, default=None,
                        help="PPO: clip the value loss as CleanRL's Atari PPO does (default on)")
+    train.add_argument("--game-input", action=argparse.BooleanOptionalAction, default=None,
+                       help="multitask: the game's one-hot joins the network's features (default on; off: the "
+                            "screen alone tells the games apart)")
     for name, kind in ENV_FLAGS.items():
         train.add_argument("--" + name.replace("_", "-"), type=kind, default=None,
                            help="an env option for every game (octax_core.make); default: the game's")
@@ -95,13 +102,12 @@ def config_from_args(args: argparse.Namespace):
     _import_train()
     from octax_gym.train import preset, resolve_games
 
-    given = {name: getattr(args, name) for name in (*SETTINGS, "anneal_lr", "clip_value_loss")
+    given = {name: getattr(args, name) for name in (*SETTINGS, "anneal_lr", "clip_value_loss", "game_input")
              if getattr(args, name) is not None}
-    other = PQN_ONLY if args.algorithm == "ppo" else PPO_ONLY
-    if wrong := [name for name in given if name in other]:
+    if wrong := [name for name in given if name in NOT_OF[args.algorithm]]:
         flags = ", ".join("--" + n.replace("_", "-") for n in wrong)
-        raise ValueError(f"{flags}: not a setting of {args.algorithm} (they belong to "
-                         f"{'pqn' if args.algorithm == 'ppo' else 'ppo'})")
+        owners = sorted({a for a, names in NOT_OF.items() if not set(wrong) & set(names)} - {args.algorithm})
+        raise ValueError(f"{flags}: not a setting of {args.algorithm} (of {' and '.join(owners)})")
     if args.games is not None:
         given["games"] = resolve_games(args.games)
     for name in ("devices", "agent_map"):
@@ -130,7 +136,7 @@ def _cmd_train(args: argparse.Namespace) -> int:
 def _resumed(args: argparse.Namespace):
     """The config of the run in `--resume OUT` (its config.json); refuses other settings."""
     defaults = {"games": None, "preset": "cpu", "devices": None, "agent_map": None, "out_dir": None, "anneal_lr": None,
-                "clip_value_loss": None, **{n: None for n in (*SETTINGS, *ENV_FLAGS)}}
+                "clip_value_loss": None, "game_input": None, **{n: None for n in (*SETTINGS, *ENV_FLAGS)}}
     if given := [name for name, default in defaults.items() if getattr(args, name) != default]:
         raise ValueError(f"--resume takes the run's own settings (OUT/config.json); drop "
                          f"{', '.join('--' + n.replace('_', '-') for n in given)}")

@@ -24,18 +24,18 @@ class Trainer(NamedTuple):
     init: Callable  # (key, game) -> runner
     collect: Callable  # runner -> (runner, batch, metrics): one rollout and its targets
     learn: Callable  # (runner, batch) -> (runner, stats): the epochs of minibatch steps
-    greedy: Callable  # (params, key, obs, legal) -> actions: the largest logit or Q-value
-    sampled: Callable  # (params, key, obs, legal) -> actions: PPO's policy, PQN's eval epsilon-greedy
+    greedy: Callable  # (params, key, obs, game) -> actions: the largest logit or Q-value of the game's
+    sampled: Callable  # (params, key, obs, game) -> actions: PPO's policy, PQN's eval epsilon-greedy
     metric_names: tuple[str, ...]  # per-update metrics, averaged between evaluations in the CSV
     host_metrics: Callable  # update index -> {name: value} for schedules (learning rate, epsilon)
 
 
 def make_trainer(config: TrainConfig, lanes: Lanes) -> Trainer:
     """The `config.algorithm` trainer for `lanes`."""
-    if config.algorithm == "ppo":
+    if config.algorithm in ("ppo", "multitask"):
         from octax_gym.train import ppo
         return ppo.make_trainer(config, lanes)
     if config.algorithm == "pqn":
         from octax_gym.train import pqn
         return pqn.make_trainer(config, lanes)
-    raise ValueError(f"algorithm must be one of ppo, pqn, got {config.algorithm!r}")
+    raise ValueError(f"algorithm must be one of ppo, pqn, multitask, got {config.algorithm!r}")

@@ -1,6 +1,6 @@
 """What a run keeps on disk: each agent's params, and the resumable checkpoint of the whole run.
 
-* `save_agents`: `OUT/agents/<game>-seed<s>.msgpack`, one file per agent (flax serialization of
+* `save_agents`: `OUT/agents/<game>-seed<s>.msgpack` (`multitask-seed<s>`), one file per agent (flax serialization of
   `{"params": ...}`, what `octax_gym.jax_policy` and `octax-gym play --agent` read), rewritten at
   every evaluation, so a run cut short keeps its last evaluated agents.
 * `Checkpoints`: `OUT/resume/checkpoint.msgpack` (every agent's runner: params, optimizer and env
@@ -21,15 +21,11 @@ import jax.numpy as jnp
 import numpy as np
 
 
-def agent_path(out_dir: Path, game: str, seed: int) -> Path:
-    return Path(out_dir) / "agents" / f"{game}-seed{seed}.msgpack"
-
-
-def save_agents(out_dir: Path, agents: Sequence[tuple[str, int]], params, write: bool = True) -> list[Path]:
-    """Each agent's slice of `params` (leading agent axis) to its `agent_path`; every process
-    takes part (`host_values`), process 0 writes."""
+def save_agents(out_dir: Path, names: Sequence[str], params, write: bool = True) -> list[Path]:
+    """Each agent's slice of `params` (leading agent axis) to `OUT/agents/<name>.msgpack`; every
+    process takes part (`host_values`), process 0 writes."""
     params = host_values(params)
-    paths = [agent_path(out_dir, game, seed) for game, seed in agents]
+    paths = [Path(out_dir) / "agents" / f"{name}.msgpack" for name in names]
     if write:
         paths[0].parent.mkdir(parents=True, exist_ok=True)
         for i, path in enumerate(paths):

@@ -14,7 +14,7 @@ from typing import Any, Optional, Union
 from octax_core.env.games import GameSpec
 from octax_core.env.mix import MIXES
 
-ALGORITHMS = ("ppo", "pqn")
+ALGORITHMS = ("ppo", "pqn", "multitask")  # multitask: one PPO agent per seed over all the games
 DEVICES = ("", "all")
 AGENT_MAPS = ("auto", "vmap", "map")
 ENV_FLAGS = {"max_episode_steps": int, "frames_per_step": int, "repeat_action_probability": float,
@@ -62,6 +62,8 @@ class TrainConfig:
     epsilon_finish: float = 0.05
     epsilon_fraction: float = 0.1  # of total_steps, over which epsilon decays linearly
     eval_epsilon: float = 0.005  # the sampled evaluation of PQN: epsilon-greedy (the paper's code)
+    # multitask's
+    game_input: bool = True  # the game's one-hot joins the torso's features (else the screen alone tells)
 
     @property
     def batch_size(self) -> int:
@@ -80,9 +82,28 @@ class TrainConfig:
         return [game.id if isinstance(game, GameSpec) else game for game in self.games]
 
     @property
+    def multitask(self) -> bool:
+        return self.algorithm == "multitask"
+
+    @property
     def agents(self) -> list[tuple[str, int]]:
-        """(game, seed) of each agent, in the order of the agent axis: game-major."""
+        """(game, seed) of each row of the log (an evaluation of one game by one agent), game-major.
+        One agent per row, except in a multi-task run, where the agent of a seed plays every game."""
         return [(game, seed) for game in self.game_ids for seed in self.seeds]
+
+    @property
+    def agent_names(self) -> list[str]:
+        """The trained agents, in the order of the agent axis: `<game>-seed<s>`, or `multitask-seed<s>`."""
+        if self.multitask:
+            return [f"multitask-seed{seed}" for seed in self.seeds]
+        return [f"{game}-seed{seed}" for game, seed in self.agents]
+
+    @property
+    def row_agents(self) -> list[int]:
+        """For each row of `agents`, the index of the agent that plays it."""
+        if self.multitask:
+            return [i for _ in self.game_ids for i in range(self.num_seeds)]
+        return list(range(len(self.agents)))
 
     def learning_rate_at(self, update: int) -> float:
         """Adam's rate during update `update` (from 0): constant, or decaying linearly to 0 with `anneal_lr`."""
@@ -130,6 +151,9 @@ class TrainConfig:
                 raise ValueError(f"{name} must be in [0, 1], got {getattr(self, name)}")
         for name, value in self.env_overrides:
             _choice("env override", name, tuple(ENV_FLAGS))
+        if self.multitask and self.num_envs % len(self.games):
+            raise ValueError(f"multitask: num_envs = {self.num_envs} must be a multiple of the {len(self.games)} "
+                             "games (lane i plays game i mod G, so each game gets as many lanes)")
         return self
 
 

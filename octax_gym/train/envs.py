@@ -56,10 +56,12 @@ class Lanes:
         return int(np.asarray(self.params.max_episode_steps)[game])
 
     def reset(self, key: jax.Array, game, num_envs: int, evaluation: bool = False):
-        """`num_envs` new episodes of `game` (an index into `games`), from `num_envs` keys split from `key`."""
+        """`num_envs` new episodes of `game` (an index into `games`, or one per lane), from
+        `num_envs` keys split from `key`."""
         env, params = (self.eval_env, self.eval_params) if evaluation else (self.env, self.params)
         keys = jax.random.split(key, num_envs)
-        return jax.vmap(lambda k: env.reset(k, params, game=game))(keys)
+        games = jnp.broadcast_to(jnp.asarray(game, jnp.int32), (num_envs,))
+        return jax.vmap(lambda k, g: env.reset(k, params, game=g))(keys, games)
 
     def step(self, key: jax.Array, state, action: jax.Array):
         """One step of a batch of training lanes, each restarting its own game where an episode ended.

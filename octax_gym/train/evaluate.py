@@ -43,12 +43,9 @@ def make_evaluate(lanes: Lanes, trainer: Trainer, num_envs: int, max_steps: int)
     Each of `num_envs` evaluation lanes plays one episode of `game` per policy, until every episode
     has ended or `max_steps` steps; a cut episode keeps its return so far.
     """
-    legal_of = jnp.asarray(lanes.legal)
-
     def play(policy, params, key, game):
         reset_key, key = jax.random.split(key)
         obs, state = lanes.reset(reset_key, game, num_envs, evaluation=True)
-        legal = legal_of[game]
         carry = (jnp.int32(0), key, obs, state, jnp.zeros(num_envs, jnp.float32), jnp.zeros(num_envs, jnp.bool_))
 
         def running(carry):
@@ -58,7 +55,7 @@ def make_evaluate(lanes: Lanes, trainer: Trainer, num_envs: int, max_steps: int)
         def body(carry):
             t, key, obs, state, returns, ended = carry
             key, act_key, step_key = jax.random.split(key, 3)
-            action = policy(params, act_key, obs, legal)
+            action = policy(params, act_key, obs, game)
             obs, state, reward, terminated, truncated, _ = lanes.eval_step(step_key, state, action)
             # Ended episodes stand still and pay 0 (no autoreset), so summing is safe.
             return t + 1, key, obs, state, returns + reward, ended | terminated | truncated

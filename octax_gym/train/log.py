@@ -45,11 +45,14 @@ class ProgressLog:
     """Appends the rows of each evaluation to `out_dir/progress.csv`."""
 
     def __init__(self, out_dir: Path, agents: Sequence[tuple[str, int]], metric_names: Sequence[str],
-                 keep_until: Optional[int] = None, write: bool = True):
-        """A new log; or, with `keep_until` (a resumed run's update), the existing rows up to that
-        update, rewritten without the rows a killed run logged after its checkpoint."""
+                 row_agents: Sequence[int], keep_until: Optional[int] = None, write: bool = True):
+        """A new log of a row per (game, seed) of `agents`, each played by agent `row_agents[i]`
+        (training statistics are that agent's); or, with `keep_until` (a resumed run's update),
+        the existing rows up to that update, rewritten without the rows a killed run logged after
+        its checkpoint."""
         self.csv_path = Path(out_dir) / "progress.csv"
         self.agents, self.metric_names, self.rows, self.write = list(agents), tuple(metric_names), [], write
+        self.row_agents = list(row_agents)
         self.columns = COMMON_COLUMNS + self.metric_names
         if not write:
             return
@@ -63,27 +66,29 @@ class ProgressLog:
 
     def add(self, update: int, step: int, wall_s: float, train_s: float, evaluation, totals: dict,
             host_metrics: dict) -> list[dict]:
-        """Rows for one evaluation: `evaluation` an `Evaluation` of (num_agents, eval_envs) arrays;
+        """Rows for one evaluation: `evaluation` an `Evaluation` of (num_rows, eval_envs) arrays;
         `totals` each metric's (num_agents,) sum over the updates since the last evaluation."""
         greedy, sampled = np.asarray(evaluation.greedy_return), np.asarray(evaluation.sampled_return)
         ended = np.concatenate([np.asarray(evaluation.greedy_ended), np.asarray(evaluation.sampled_ended)], axis=1)
         n = totals.get("updates", 0)
         rows = []
+        num_agents = len(set(self.row_agents))
         for i, (game, seed) in enumerate(self.agents):
-            episodes = float(totals["finished_episodes"][i]) if n else 0.0
+            a = self.row_agents[i]
+            episodes = float(totals["finished_episodes"][a]) if n else 0.0
             mean = float(sampled[i].mean())
             row = {"game": game, "seed": seed, "step": step, "update": update, "wall_s": round(wall_s, 2),
-                   "env_steps_per_s": round(step * len(self.agents) / train_s, 1) if train_s else math.nan,
+                   "env_steps_per_s": round(step * num_agents / train_s, 1) if train_s else math.nan,
                    "eval_mean_return": mean, "eval_std": float(sampled[i].std()),
                    "eval_greedy_return": float(greedy[i].mean()), "eval_greedy_std": float(greedy[i].std()),
                    "eval_sampled_return": mean, "eval_sampled_std": float(sampled[i].std()),
                    "eval_ended_frac": float(ended[i].mean()), "random_mean_return": baseline(game)[0],
                    "normalized_score": normalized(game, mean),
-                   "train_episode_return": (float(totals["finished_return_sum"][i]) / episodes
+                   "train_episode_return": (float(totals["finished_return_sum"][a]) / episodes
                                             if episodes else math.nan),
                    "train_episodes": int(episodes)}
             for name in self.metric_names:
-                row[name] = float(totals[name][i]) / n if n and name in totals else host_metrics.get(name, math.nan)
+                row[name] = float(totals[name][a]) / n if n and name in totals else host_metrics.get(name, math.nan)
             rows.append(row)
         self.rows.extend(rows)
         if self.write:

@@ -50,26 +50,37 @@ def train(config: TrainConfig, out_dir, *, roms: Optional[Sequence] = None, prog
     lanes = Lanes(config.games, dict(config.env_overrides), config.eval_noop_max, roms)  # refuses a bad mix
     out_dir.mkdir(parents=True, exist_ok=True)
     trainer = make_trainer(config, lanes)
-    agents = config.agents
-    num_agents = len(agents)
+    rows = config.agents  # (game, seed) of each evaluation row
+    num_agents = len(config.agent_names)
     options = lanes.compiler_options  # every jit that steps the env takes its platform's options
     eval_steps = config.eval_max_steps or int(np.asarray(lanes.params.max_episode_steps).max())
-    evaluate = jax.jit(over_agents(make_evaluate(lanes, trainer, config.eval_envs, eval_steps), num_agents,
-                                   config.agent_map), compiler_options=options)
+    evaluate_rows = over_agents(make_evaluate(lanes, trainer, config.eval_envs, eval_steps), len(rows), config.agent_map)
+    row_agents = np.asarray(config.row_agents)
+    if config.multitask:  # each seed's one agent plays every game's evaluation
+        evaluate = jax.jit(lambda params, keys, games: evaluate_rows(
+            jax.tree.map(lambda x: x[row_agents], params), keys, games), compiler_options=options)
+    else:
+        evaluate = jax.jit(evaluate_rows, compiler_options=options)
 
     if not resume and writer:
         (out_dir / "config.json").write_text(json.dumps(
             {"command": sys.argv, **dataclasses.asdict(config), "games": config.game_ids}, indent=2, default=str)
             + "\n")
-    games = np.repeat(np.arange(len(config.games)), config.num_seeds)  # game-major, as config.agents
-    train_keys, eval_keys = agent_keys([seed for _, seed in agents])
+    row_games = np.repeat(np.arange(len(config.games)), config.num_seeds)  # game-major, as config.agents
+    if config.multitask:  # lane i of every agent plays game i mod G
+        games = [np.arange(config.num_envs) % len(config.games)] * config.num_seeds
+        train_keys = agent_keys(config.seeds)[0]
+    else:
+        games = row_games
+        train_keys = agent_keys([seed for _, seed in rows])[0]
+    eval_keys = agent_keys([seed for _, seed in rows])[1]
     runner = init_agents(trainer.init, train_keys, games)
     checkpoints = Checkpoints(out_dir / "resume", write=writer)
     start_at = None
     if resume:
         runner, start_at = checkpoints.load(runner)
         print(f"resuming {out_dir} at update {start_at['update']} of {config.num_updates}")
-    game_ids = jnp.asarray(games, jnp.int32)
+    game_ids = jnp.asarray(row_games, jnp.int32)
     shardings = {}
     if config.devices:
         parallel = DataParallel(config)
@@ -84,9 +95,9 @@ def train(config: TrainConfig, out_dir, *, roms: Optional[Sequence] = None, prog
           f"agent{'s' * (num_agents > 1)} x {config.num_envs} envs x {config.num_steps} steps, "
           f"{config.num_updates} updates)")
 
-    title = (f"{trainer.name}, {len(config.games)} game{'s' * (len(config.games) > 1)} x {config.num_seeds} "
+    title = (f"{'multi-task ' * config.multitask}{trainer.name}, {len(config.games)} game{'s' * (len(config.games) > 1)} x {config.num_seeds} "
              f"seed{'s' * (config.num_seeds > 1)} ({config.num_envs} envs x {config.num_steps} steps)")
-    log = ProgressLog(out_dir, agents, trainer.metric_names,
+    log = ProgressLog(out_dir, rows, trainer.metric_names, row_agents,
                       keep_until=None if start_at is None else start_at["update"], write=writer)
     bar = tqdm(total=config.num_updates * config.batch_size * num_agents, unit="step", unit_scale=True,
                disable=not progress or not writer, desc=f"{trainer.name} x{num_agents}")
@@ -98,7 +109,7 @@ def train(config: TrainConfig, out_dir, *, roms: Optional[Sequence] = None, prog
         result = jax.device_get(evaluate(runner.params, fold(eval_keys, i), game_ids))
         rows = log.add(i, i * config.batch_size, time.perf_counter() - start, train_s, result, totals,
                        trainer.host_metrics(i))
-        save_agents(out_dir, agents, runner.params, write=writer)
+        save_agents(out_dir, config.agent_names, runner.params, write=writer)
         if writer:
             figure.draw(log.rows, config.game_ids, out_dir / "learning_curve.png", title)
         bar.set_postfix(eval=f"{np.mean([r['eval_mean_return'] for r in rows]):.2f}")
@@ -113,7 +124,7 @@ def train(config: TrainConfig, out_dir, *, roms: Optional[Sequence] = None, prog
           f"(rollout, targets and epochs; compile and evaluation excluded); wall {time.perf_counter() - start:.0f} s")
     print(report.table(summary))
     return {**summary, "out_dir": out_dir, "csv": log.csv_path, "png": out_dir / "learning_curve.png",
-            "agent_paths": [out_dir / "agents" / f"{g}-seed{s}.msgpack" for g, s in agents],
+            "agent_paths": [out_dir / "agents" / f"{name}.msgpack" for name in config.agent_names],
             "env_steps_per_s": steps_per_s, "train_s": train_s, "rows": log.rows,
             "final_params": host_values(runner.params)}
 
@@ -156,5 +167,5 @@ def _updates(config: TrainConfig, update, runner, evaluated, checkpoints: Checkp
         for k, v in metrics.items():
             totals[k] = totals.get(k, 0.0) + np.asarray(v, np.float64)
         totals["updates"] = totals.get("updates", 0) + 1
-        bar.update(config.batch_size * len(config.agents))
+        bar.update(config.batch_size * len(config.agent_names))
     return runner, train_s

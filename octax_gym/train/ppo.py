@@ -30,43 +30,52 @@ class OldPolicy(NamedTuple):
     value: jax.Array  # (num_envs,) float32, the critic's
 
 
-def make_trainer(config: TrainConfig, lanes: Lanes, network: ActorCritic = None) -> Trainer:
-    """PPO for the run's lanes: a `Trainer` of one agent (the loop maps it over agents and compiles it)."""
-    network = network or ActorCritic()
-    optimizer = shared.make_optimizer(config)
+def make_trainer(config: TrainConfig, lanes: Lanes) -> Trainer:
+    """PPO for the run's lanes: a `Trainer` of one agent (the loop maps it over agents and compiles it).
 
-    def act(params, key, obs, legal, _):
-        logits, value = network.apply(params, obs)
-        logits = masked(logits, legal)
+    `config.multitask`: one agent over all the games, its lanes' games (and with `game_input` the
+    game's one-hot, `ActorCritic(num_games=G)`) read per lane; otherwise one agent, one game.
+    """
+    num_games = len(lanes.games) if config.multitask and config.game_input else 0
+    network, optimizer = ActorCritic(num_games=num_games), shared.make_optimizer(config)
+    legal_of = jnp.asarray(lanes.legal)
+
+    def net_input(obs, game):
+        return (obs, jnp.broadcast_to(game, obs.shape[:1])) if num_games else obs
+
+    def apply(params, obs, game):
+        logits, value = network.apply(params, net_input(obs, game))
+        return masked(logits, legal_of[game]), value
+
+    def act(params, key, obs, game, _):
+        logits, value = apply(params, obs, game)
         action = jax.random.categorical(key, logits)
         log_prob = jnp.take_along_axis(jax.nn.log_softmax(logits), action[:, None], 1)[:, 0]
         return action, OldPolicy(log_prob, value)
 
-    def critic(params, obs, legal):
-        return network.apply(params, obs)[1]
+    def critic(params, obs, game):
+        return apply(params, obs, game)[1]
 
     rollout = shared.make_rollout(config, lanes, act, critic)
+    learn = shared.make_learn(config, optimizer, lambda params, minibatch: ppo_loss(params, apply, config, minibatch))
 
     def collect(runner: shared.RunnerState):
         runner, traj = rollout(runner)
         old = traj.policy_out
-        last_value = critic(runner.params, runner.obs, None)
+        last_value = critic(runner.params, runner.obs, runner.game)
         advantages, targets = gae(traj.reward, traj.done, old.value, last_value, config.gamma, config.gae_lambda)
-        return runner, (traj.obs, traj.action, old.log_prob, old.value, advantages, targets), shared.episode_totals(traj)
+        games = jnp.broadcast_to(runner.game, traj.action.shape)  # each sample's game: its mask (and input)
+        batch = (traj.obs, games, traj.action, old.log_prob, old.value, advantages, targets)
+        return runner, batch, shared.episode_totals(traj)
 
-    def learn(runner: shared.RunnerState, batch):
-        legal = jnp.asarray(lanes.legal)[runner.game]
-        return shared.make_learn(config, optimizer, lambda params, minibatch: ppo_loss(
-            params, network, config, legal, minibatch))(runner, batch)
+    def greedy(params, key, obs, game):
+        return jnp.argmax(apply(params, obs, game)[0], axis=1).astype(jnp.int32)
 
-    def greedy(params, key, obs, legal):
-        return jnp.argmax(masked(network.apply(params, obs)[0], legal), axis=1).astype(jnp.int32)
+    def sampled(params, key, obs, game):
+        return jax.random.categorical(key, apply(params, obs, game)[0]).astype(jnp.int32)
 
-    def sampled(params, key, obs, legal):
-        return jax.random.categorical(key, masked(network.apply(params, obs)[0], legal)).astype(jnp.int32)
-
-    return Trainer("PPO", network, shared.make_init(config, lanes, network, optimizer), collect, learn, greedy,
-                   sampled, METRICS, lambda i: {"learning_rate": config.learning_rate_at(i)})
+    return Trainer("PPO", network, shared.make_init(config, lanes, network, optimizer, net_input), collect, learn,
+                   greedy, sampled, METRICS, lambda i: {"learning_rate": config.learning_rate_at(i)})
 
 
 def gae(reward: jax.Array, done: jax.Array, value: jax.Array, last_value: jax.Array, gamma: float, lam: float):
@@ -85,11 +94,12 @@ def gae(reward: jax.Array, done: jax.Array, value: jax.Array, last_value: jax.Ar
     return advantages, advantages + value
 
 
-def ppo_loss(params, network: ActorCritic, config: TrainConfig, legal: jax.Array, minibatch):
-    """The clipped surrogate, the (clipped) value loss and the entropy bonus, over masked logits."""
-    obs, action, old_log_prob, old_value, advantage, target = minibatch
-    logits, value = network.apply(params, obs)
-    log_probs = jax.nn.log_softmax(masked(logits, legal))
+def ppo_loss(params, apply, config: TrainConfig, minibatch):
+    """The clipped surrogate, the (clipped) value loss and the entropy bonus, over masked logits
+    (`apply(params, obs, game) -> (masked logits, values)`)."""
+    obs, game, action, old_log_prob, old_value, advantage, target = minibatch
+    logits, value = apply(params, obs, game)
+    log_probs = jax.nn.log_softmax(logits)
     log_prob = jnp.take_along_axis(log_probs, action[:, None], 1)[:, 0]
     entropy = -(jnp.exp(log_probs) * log_probs).sum(-1).mean()
     log_ratio = log_prob - old_log_prob

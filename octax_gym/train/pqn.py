@@ -35,31 +35,31 @@ def epsilon_greedy(q_values: jax.Array, key: jax.Array, epsilon, legal: jax.Arra
 def make_trainer(config: TrainConfig, lanes: Lanes) -> Trainer:
     """PQN for the run's lanes: a `Trainer` of one agent (the loop maps it over agents and compiles it)."""
     network, optimizer = QNetwork(), shared.make_optimizer(config)
+    legal_of = jnp.asarray(lanes.legal)
 
-    def explore(params, key, obs, legal, epsilon):
+    def explore(params, key, obs, game, epsilon):
         q_values = network.apply(params, obs)
-        return epsilon_greedy(q_values, key, epsilon, legal), masked(q_values, legal).max(axis=1)
+        return epsilon_greedy(q_values, key, epsilon, legal_of[game]), masked(q_values, legal_of[game]).max(axis=1)
 
-    def max_q(params, obs, legal):
-        return masked(network.apply(params, obs), legal).max(axis=1)
+    def max_q(params, obs, game):
+        return masked(network.apply(params, obs), legal_of[game]).max(axis=1)
 
     rollout = shared.make_rollout(config, lanes, explore, max_q)
     learn = shared.make_learn(config, optimizer, lambda params, minibatch: td_loss(params, network, minibatch))
 
     def collect(runner: shared.RunnerState):
-        legal = jnp.asarray(lanes.legal)[runner.game]
         epsilon = config.epsilon(runner.updates)
         runner, traj = rollout(runner, epsilon)
-        targets = q_lambda_targets(traj.reward, traj.done, traj.policy_out, max_q(runner.params, runner.obs, legal),
+        targets = q_lambda_targets(traj.reward, traj.done, traj.policy_out, max_q(runner.params, runner.obs, runner.game),
                                    config.gamma, config.q_lambda)
         metrics = {"target_mean": targets.mean(), "epsilon": epsilon, **shared.episode_totals(traj)}
         return runner, (traj.obs, traj.action, targets), metrics
 
-    def greedy(params, key, obs, legal):
-        return jnp.argmax(masked(network.apply(params, obs), legal), axis=1).astype(jnp.int32)
+    def greedy(params, key, obs, game):
+        return jnp.argmax(masked(network.apply(params, obs), legal_of[game]), axis=1).astype(jnp.int32)
 
-    def sampled(params, key, obs, legal):
-        return epsilon_greedy(network.apply(params, obs), key, config.eval_epsilon, legal)
+    def sampled(params, key, obs, game):
+        return epsilon_greedy(network.apply(params, obs), key, config.eval_epsilon, legal_of[game])
 
     return Trainer("PQN", network, shared.make_init(config, lanes, network, optimizer), collect, learn, greedy,
                    sampled, METRICS, lambda i: {"learning_rate": config.learning_rate_at(i), "epsilon": float(config.epsilon(i))})

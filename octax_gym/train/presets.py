@@ -23,6 +23,7 @@ PAPER = {
     "pqn": dict(_PAPER_COMMON, max_grad_norm=10.0, q_lambda=0.9, epsilon_start=1.0, epsilon_finish=0.05,
                 epsilon_fraction=0.1, eval_epsilon=0.005),
 }
+PAPER["multitask"] = PAPER["ppo"]  # the multi-task agent learns with PPO
 _CPU_SCALE = dict(total_steps=655_360, num_envs=64, num_steps=32, num_minibatches=8, eval_every=65_536,
                   eval_envs=32)
 CPU = {algorithm: dict(settings, **_CPU_SCALE) for algorithm, settings in PAPER.items()}

@@ -32,7 +32,7 @@ class RunnerState(NamedTuple):
     episode_return: jax.Array  # (num_envs,) float32, return so far of each running episode
     key: jax.Array
     updates: jax.Array  # () int32: updates done, for schedules (PQN's epsilon)
-    game: jax.Array  # () int32: the agent's game, an index into the run's games
+    game: jax.Array  # () int32: the agent's game, an index into the run's games; multitask: (num_envs,), per lane
 
 
 class Transition(NamedTuple):
@@ -54,14 +54,16 @@ def make_optimizer(config: TrainConfig) -> optax.GradientTransformation:
     return optax.chain(optax.clip_by_global_norm(config.max_grad_norm), optax.adam(lr))
 
 
-def make_init(config: TrainConfig, lanes: Lanes, network, optimizer: optax.GradientTransformation) -> Callable:
+def make_init(config: TrainConfig, lanes: Lanes, network, optimizer: optax.GradientTransformation,
+              net_input: Callable = lambda obs, game: obs) -> Callable:
     """`init(key, game) -> RunnerState`: fresh network params, optimizer state and `num_envs`
-    lanes of `game` just reset. The network's init does not read the game: agents of one seed
-    start from the same weights whatever their game."""
+    lanes of `game` (one game, or one per lane) just reset. The network's init reads the game only
+    where `net_input` gives it (a multi-task agent): agents of one seed start from the same weights
+    whatever their game."""
     def init(key: jax.Array, game: jax.Array) -> RunnerState:
         key, net_key, env_key = jax.random.split(key, 3)
         obs, env_state = lanes.reset(env_key, game, config.num_envs)
-        params = network.init(net_key, obs[:1])
+        params = network.init(net_key, net_input(obs[:1], jnp.broadcast_to(game, (config.num_envs,))[:1]))
         return RunnerState(params, optimizer.init(params), env_state, obs,
                            jnp.zeros(config.num_envs, jnp.float32), key, jnp.int32(0), game)
 
@@ -73,27 +75,23 @@ def make_rollout(config: TrainConfig, lanes: Lanes, act: Callable, bootstrap: Ca
     under `lax.scan`, `traj` a `Transition` of (num_steps, num_envs, ...) arrays.
 
     Args:
-      act: `(params, key, obs, legal, act_arg) -> (action, policy_out)`, the behaviour policy on a
-        batch of observations (`legal`: (ACTIONS,) bool, the agent's game's actions);
+      act: `(params, key, obs, game, act_arg) -> (action, policy_out)`, the behaviour policy on a
+        batch of observations (`game`: the agent's game, or one per lane: what sets the legal actions);
         `policy_out` (a pytree of (num_envs, ...) arrays) is kept for the targets and the loss.
         `act_arg` is what the policy takes per rollout (PQN's epsilon; PPO's is None).
-      bootstrap: `(params, obs, legal) -> (num_envs,)` value of observations (PPO's critic, PQN's
+      bootstrap: `(params, obs, game) -> (num_envs,)` value of observations (PPO's critic, PQN's
         max Q), credited to a truncated episode's last reward.
     """
-    shared = vmapped(config.agent_map, len(config.agents))  # a predicate all agents share keeps the cond
-    legal_of = jnp.asarray(lanes.legal)
-
+    shared = vmapped(config.agent_map, len(config.agent_names))  # a predicate all agents share keeps the cond
     def rollout(runner: RunnerState, act_arg=None):
-        legal = legal_of[runner.game]
-
         def env_step(runner: RunnerState, _):
             key, action_key, step_key = jax.random.split(runner.key, 3)
-            action, policy_out = act(runner.params, action_key, runner.obs, legal, act_arg)
+            action, policy_out = act(runner.params, action_key, runner.obs, runner.game, act_arg)
             obs, env_state, reward, terminated, truncated, final_obs = lanes.step(step_key, runner.env_state, action)
             # Partial-episode bootstrapping: a time limit is not a terminal state, so a truncated
             # episode is credited gamma * value(its last observation). Rare, so the network runs only then.
             final_value = jax.lax.cond(any_over_agents(truncated, shared),
-                                       lambda: bootstrap(runner.params, final_obs, legal),
+                                       lambda: bootstrap(runner.params, final_obs, runner.game),
                                        lambda: jnp.zeros(config.num_envs, jnp.float32))
             done = terminated | truncated
             episode_return = runner.episode_return + reward
