@@ -7,7 +7,10 @@ third-party data comes from, and what happens without ../shared: tests/shared_da
 
 from __future__ import annotations
 
+import collections
 import functools
+import json
+import math
 import os
 from pathlib import Path
 
@@ -34,6 +37,57 @@ os.environ.setdefault("JAX_PERSISTENT_CACHE_MIN_COMPILE_TIME_SECS", "0")
 jax.config.update("jax_compilation_cache_dir", _JAX_CACHE)
 jax.config.update("jax_persistent_cache_min_compile_time_secs",
                   float(os.environ["JAX_PERSISTENT_CACHE_MIN_COMPILE_TIME_SECS"]))
+
+
+# Longest files first: pytest-xdist hands each worker whole files (`--dist loadfile`) in collection
+# order, so a long file collected last keeps one worker busy while the other waits. Each run records
+# its files' seconds here (controller only, merged with earlier runs' files) and the next run
+# schedules them longest first, new files before all; within a file the order is kept.
+_FILE_SECONDS = Path(__file__).resolve().parent.parent / ".cache" / "test-file-seconds.json"
+_SECONDS_THIS_RUN: collections.Counter = collections.Counter()
+
+
+def _recorded_file_seconds() -> dict:
+    try:
+        seconds = json.loads(_FILE_SECONDS.read_text())
+    except (OSError, ValueError):
+        return {}
+    return seconds if isinstance(seconds, dict) else {}
+
+
+def pytest_configure(config):
+    if _recorded_file_seconds() and hasattr(config.option, "loadscopereorder"):
+        config.option.loadscopereorder = False  # xdist would queue files by test count, not this order
+
+
+def pytest_collection_modifyitems(config, items):
+    seconds = _recorded_file_seconds()
+    if not seconds:
+        return
+    first_seen: dict = {}
+    for item in items:
+        first_seen.setdefault(item.nodeid.split("::")[0], len(first_seen))
+
+    def longest_first(item):
+        file = item.nodeid.split("::")[0]
+        return -float(seconds.get(file, math.inf)), first_seen[file]
+
+    items.sort(key=longest_first)  # stable: a file's tests keep their order
+
+
+def pytest_runtest_logreport(report):
+    _SECONDS_THIS_RUN[report.nodeid.split("::")[0]] += report.duration
+
+
+def pytest_sessionfinish(session):
+    if hasattr(session.config, "workerinput") or not _SECONDS_THIS_RUN:
+        return  # an xdist worker: the controller sees every worker's reports and writes once
+    seconds = {**_recorded_file_seconds(), **{f: round(t, 2) for f, t in _SECONDS_THIS_RUN.items()}}
+    try:
+        _FILE_SECONDS.parent.mkdir(parents=True, exist_ok=True)
+        _FILE_SECONDS.write_text(json.dumps(seconds, indent=0, sort_keys=True))
+    except OSError:
+        pass  # a read-only clone: the order stays the collection's
 
 
 def pytest_runtest_setup(item):
