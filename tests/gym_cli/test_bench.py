@@ -267,3 +267,19 @@ def test_platforms_same_program_runs_one_chip8_program_on_every_platform(octax_r
         for line in later:  # the ratio is the platform's instructions/s over chip8's
             assert float(line["ratio"]) == pytest.approx(int(line["ips"]) / int(chip8["ips"]), abs=0.002)
     # its refusal of a game that is not CHIP-8: test_the_scripts_report_usage_errors
+
+
+@pytest.mark.slow  # compiles a PPO update (about 10 s)
+def test_train_throughput_counts_the_network_flops_per_step(octax_rom_dir):
+    result = subprocess.run(
+        [sys.executable, "benchmarks/train_throughput.py", "--games", "Airplane", "--num-envs", "8",
+         "--num-minibatches", "2", "--updates", "1", "--matmul-size", "256"],
+        capture_output=True, text=True, timeout=600, cwd=REPO, check=False)
+    assert result.returncode == 0, result.stderr
+    line, = harness.parse_bench_lines(result.stdout, "train_throughput")
+    assert line["algo"] == "ppo" and line["agents"] == "1" and line["envs"] == "8"
+    # the paper's network: a forward pass to act and 4 gradients (about 3 passes each) a step,
+    # some 6 MFLOP a pass (3.2M multiply-adds), so tens of MFLOP, not the loop-undercounted few
+    assert 40 < float(line["mflop_per_step"]) < 150
+    assert 0 < float(line["fraction"]) and int(line["sps"]) > 0
+    assert float(line["gflops"]) == pytest.approx(float(line["mflop_per_step"]) * int(line["sps"]) / 1e3, rel=0.01)
