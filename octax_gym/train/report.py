@@ -38,14 +38,28 @@ def summarize(rows: Sequence[dict], games: Sequence[str], seeds: Sequence[int]) 
         matrix.append([normalized(game, v) for v in sampled])
     out = {"games": per_game}
     matrix = np.array(matrix, np.float64).T  # (seeds, games)
-    if matrix.size and not np.isnan(matrix).any():
-        interval = scores.stratified_bootstrap_ci(matrix, scores.iqm, reps=REPS)
-        out["normalized_iqm"] = {"point": interval.point, "ci": [interval.low, interval.high]}
+    scored = [i for i in range(len(games)) if matrix.size and not np.isnan(matrix[:, i]).any()]
+    if scored:  # games without a reference score (Tetris) have no normalized score: left out, and named
+        interval = scores.stratified_bootstrap_ci(matrix[:, scored], scores.iqm, reps=REPS)
+        out["normalized_iqm"] = {"point": interval.point, "ci": [interval.low, interval.high],
+                                 "games": [games[i] for i in scored],
+                                 "left_out": [g for i, g in enumerate(games) if i not in scored]}
     return out
 
 
 def write(summary: dict, path: Path) -> None:
-    Path(path).write_text(json.dumps(summary, indent=2, default=_plain) + "\n")
+    """Strict JSON: a score that is not a number (a game without a reference score) is null."""
+    Path(path).write_text(json.dumps(_finite(summary), indent=2, default=_plain, allow_nan=False) + "\n")
+
+
+def _finite(x):
+    if isinstance(x, dict):
+        return {k: _finite(v) for k, v in x.items()}
+    if isinstance(x, (list, tuple)):
+        return [_finite(v) for v in x]
+    if isinstance(x, (float, np.floating)) and not math.isfinite(float(x)):
+        return None
+    return x
 
 
 def table(summary: dict) -> str:
@@ -57,7 +71,8 @@ def table(summary: dict) -> str:
                      f"{_num(g['normalized_iqm']):>6}")
     if "normalized_iqm" in summary:
         n = summary["normalized_iqm"]
-        lines.append(f"normalized IQM over all runs: {n['point']:.3f} [{n['ci'][0]:.3f}, {n['ci'][1]:.3f}]")
+        over = "all runs" if not n["left_out"] else f"the games with a reference score (not {', '.join(n['left_out'])})"
+        lines.append(f"normalized IQM over {over}: {n['point']:.3f} [{n['ci'][0]:.3f}, {n['ci'][1]:.3f}]")
     return "\n".join(lines)
 
 

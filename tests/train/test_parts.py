@@ -102,3 +102,22 @@ def test_agent_map_one_by_one_is_bit_exact_where_vmap_is_not():
 
     assert _bits_of_agent(grad, params, obs, "map")
     assert not _bits_of_agent(grad, params, obs, "vmap")  # if this ever holds, "vmap" could be the CPU default
+
+
+def test_a_game_without_a_reference_score_is_named_left_out_and_written_as_null(tmp_path):
+    """Tetris has no reference score, so no normalized score: the IQM over games is the other
+    games', says which were left out, and summary.json stays strict JSON (null, not NaN)."""
+    import json
+
+    from octax_gym.train import report
+
+    rows = [{"game": g, "seed": s, "step": 8, "eval_mean_return": r + s, "eval_greedy_return": r}
+            for g, r in (("Airplane", 2.0), ("Tetris", 0.0)) for s in (0, 1)]
+    summary = report.summarize(rows, ["Airplane", "Tetris"], [0, 1])
+    assert summary["normalized_iqm"]["games"] == ["Airplane"]
+    assert summary["normalized_iqm"]["left_out"] == ["Tetris"]
+    assert "not Tetris" in report.table(summary)
+    report.write(summary, tmp_path / "summary.json")
+    text = (tmp_path / "summary.json").read_text()
+    strict = json.loads(text, parse_constant=lambda name: pytest.fail(f"summary.json holds {name}"))
+    assert strict["games"]["Tetris"]["normalized_iqm"] is None
