@@ -16,22 +16,17 @@ from octax_gym.jax_policy import describe, load_params  # noqa: E402
 from octax_gym.train import preset  # noqa: E402
 from octax_gym.train.algorithm import make_trainer  # noqa: E402
 from octax_gym.train.envs import Lanes  # noqa: E402
-
-TINY = ["--num-envs", "4", "--num-steps", "8", "--num-minibatches", "2", "--update-epochs", "1",
-        "--total-steps", "64", "--eval-every", "32", "--eval-envs", "2", "--eval-max-steps", "30",
-        "--max-episode-steps", "20", "--no-progress"]
+from tiny_run import STEPS  # noqa: E402
 
 
-def test_one_agent_plays_every_game(tmp_path):
-    out = tmp_path / "mt"
-    assert main(["train", "multitask", "--games", "Airplane,Deep8", "--num-seeds", "2", *TINY,
-                 "--out-dir", str(out)]) == 0
+def test_one_agent_plays_every_game(trained):
+    out = trained("multitask", "--games", "Airplane,Deep8", "--num-seeds", "2")
     with open(out / "progress.csv", newline="") as file:
         rows = list(csv.DictReader(file))
     assert [(r["game"], r["seed"], r["step"]) for r in rows] == [
-        (game, seed, step) for step in ("0", "32", "64") for game in ("Airplane", "Deep8") for seed in ("0", "1")]
+        (game, seed, str(step)) for step in STEPS for game in ("Airplane", "Deep8") for seed in ("0", "1")]
     # Training statistics are the agent's, shared by its games' rows.
-    last = [r for r in rows if r["step"] == "64"]
+    last = [r for r in rows if r["step"] == str(STEPS[-1])]
     assert last[0]["pg_loss"] == last[2]["pg_loss"] and last[0]["pg_loss"] != last[1]["pg_loss"]
     assert sorted(p.name for p in (out / "agents").iterdir()) == ["multitask-seed0.msgpack", "multitask-seed1.msgpack"]
     params = load_params(out / "agents" / "multitask-seed0.msgpack")

@@ -93,7 +93,7 @@ def _bits_of_agent(fn, params, obs, agent_map):
 
 def test_agent_map_one_by_one_is_bit_exact_where_vmap_is_not():
     network = QNetwork()
-    obs = (jax.random.uniform(jax.random.key(0), (4, 64, 4, 32, 64)) < 0.2).astype(jnp.uint8)
+    obs = (jax.random.uniform(jax.random.key(0), (4, 8, 4, 32, 64)) < 0.2).astype(jnp.uint8)  # 4 agents x 8 frames
     params = jax.tree.map(lambda *x: jnp.stack(x), *[network.init(k, obs[0, :1]) for k in jax.random.split(
         jax.random.key(1), 4)])
 

@@ -13,11 +13,7 @@ import pytest
 
 pytest.importorskip("flax")
 from octax_gym.cli import main  # noqa: E402
-
-# 6 updates of 32 steps; evaluations every 2 updates; checkpoints every 2 (the last at update 4).
-ARGS = ["--games", "Deep8", "--num-envs", "4", "--num-steps", "8", "--num-minibatches", "2", "--update-epochs", "1",
-        "--total-steps", "192", "--eval-every", "64", "--eval-envs", "2", "--eval-max-steps", "40",
-        "--max-episode-steps", "20", "--checkpoint-every", "2", "--no-progress"]
+from tiny_run import LONE, STEPS  # noqa: E402
 
 
 def table(out: Path) -> list[dict]:
@@ -26,10 +22,9 @@ def table(out: Path) -> list[dict]:
 
 
 @pytest.fixture(scope="module")
-def whole(tmp_path_factory) -> Path:
-    out = tmp_path_factory.mktemp("resume") / "whole"
-    assert main(["train", "ppo", *ARGS, "--out-dir", str(out)]) == 0
-    return out
+def whole(trained) -> Path:
+    """The lone PPO run of (Deep8, seed 1) (tiny_run.TINY: 6 updates, evaluations and checkpoints every 2)."""
+    return trained("ppo", *LONE)
 
 
 def test_a_resumed_run_ends_as_the_run_never_stopped(whole, tmp_path):
@@ -38,11 +33,11 @@ def test_a_resumed_run_ends_as_the_run_never_stopped(whole, tmp_path):
     assert json.loads((cut / "resume" / "checkpoint.json").read_text()) == {"update": 4}
     # As if killed just before its end: the checkpoint is at update 4, the last rows and agents
     # are those of update 6; the resumed run must drop the rows after update 4 and redo them.
-    (cut / "agents" / "Deep8-seed0.msgpack").write_bytes(b"stale")
+    (cut / "agents" / "Deep8-seed1.msgpack").write_bytes(b"stale")
     assert main(["train", "ppo", "--resume", str(cut), "--no-progress"]) == 0
     assert table(cut) == table(whole)
     assert [int(r["update"]) for r in table(cut)] == [0, 2, 4, 6]
-    assert (cut / "agents" / "Deep8-seed0.msgpack").read_bytes() == (whole / "agents" / "Deep8-seed0.msgpack").read_bytes()
+    assert (cut / "agents" / "Deep8-seed1.msgpack").read_bytes() == (whole / "agents" / "Deep8-seed1.msgpack").read_bytes()
 
 
 def test_resume_is_refused_for_another_algorithm_or_without_a_checkpoint(whole, tmp_path, capsys):
@@ -57,6 +52,6 @@ def test_resume_is_refused_for_another_algorithm_or_without_a_checkpoint(whole, 
 
 def test_each_evaluation_leaves_its_rows_and_agents(whole):
     rows = table(whole)
-    assert [int(r["step"]) for r in rows] == [0, 64, 128, 192]
+    assert [int(r["step"]) for r in rows] == list(STEPS)
     config = json.loads((whole / "config.json").read_text())
     assert config["games"] == ["Deep8"] and config["checkpoint_every"] == 2 and "command" in config
