@@ -5,7 +5,7 @@
 # make bench  throughput of the core on Pong, against the octax package (benchmarks/README.md)
 # make bench-scaling  the scaling figure: octax-gym, octax, EnvPool and ale-py Pong against N (docs/scaling.md)
 # make wheel-check  the wheel in a clean venv, offline, empty HOME: every archive game builds and passes check_env
-# make dataset-suite  train the six suite policies (PPO, ~10 min each here), then collect octax/<Game>/{random,medium,expert}-v0 (docs/datasets.md)
+# make dataset-suite  train the six suite policies (PPO, all in one program), then collect octax/<Game>/{random,medium,expert}-v0 (docs/datasets.md)
 # make roms   rebuild our own games, roms/*.ch8, from their Octo source roms/*.8o
 #
 # Each target creates .venv when it is missing and installs what it needs into it once: a stamp
@@ -65,19 +65,20 @@ bench-scaling: $(VENV)/.installed-dev $(VENV)/.installed-scaling
 	$(ROMS_READY)
 	$(PY) benchmarks/scaling.py $(BENCH_ARGS)
 
-# The dataset suite (docs/datasets.md): one PPO run per game with the params of every evaluation kept
-# (the medium policies come from them), then `octax-gym dataset suite`. A game whose run is finished
-# (its params.msgpack exists) is not trained again; delete runs/suite/<Game> to retrain it.
+# The dataset suite (docs/datasets.md): one `octax-gym train ppo` run of the games (an agent each, one
+# program) with every evaluation's agents kept (the medium policies come from them), then `octax-gym
+# dataset suite`. A finished run (its summary.json exists) is not trained again, a cut one is resumed
+# from its checkpoint; delete runs/suite to retrain.
 SUITE_GAMES ?= Airplane Deep8 Dodge Filter Flak Squash
 SUITE_RUNS  ?= runs/suite
 
 dataset-suite: $(VENV)/.installed-all
 	$(ROMS_READY)
-	for game in $(SUITE_GAMES); do \
-	  [ -f $(SUITE_RUNS)/$$game/params.msgpack ] || $(PY) examples/train_jax_ppo.py --game $$game --num-envs 64 \
-	    --num-steps 32 --num-minibatches 8 --total-steps 262144 --eval-every 65536 --eval-envs 32 \
-	    --eval-max-steps 2000 --save-at-evals --out-dir $(SUITE_RUNS)/$$game || exit 1; \
-	done
+	if [ -f $(SUITE_RUNS)/summary.json ]; then :; \
+	elif [ -f $(SUITE_RUNS)/resume/checkpoint.json ]; then $(PY) -m octax_gym train ppo --resume $(SUITE_RUNS) --no-progress; \
+	else $(PY) -m octax_gym train ppo --games $(shell echo $(SUITE_GAMES) | tr ' ' ,) --num-envs 64 --num-steps 32 \
+	  --num-minibatches 8 --total-steps 262144 --eval-every 65536 --eval-envs 32 --eval-max-steps 2000 \
+	  --checkpoint-every 16 --save-at-evals --no-progress --out-dir $(SUITE_RUNS); fi
 	$(PY) -m octax_gym dataset suite --runs $(SUITE_RUNS) --games $(SUITE_GAMES) $(SUITE_ARGS)
 
 # tests/core/test_own_roms.py checks that the committed ROMs are what this builds; a game's

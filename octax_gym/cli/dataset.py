@@ -83,12 +83,13 @@ def add_commands(commands: argparse._SubParsersAction) -> None:
     build = sub.add_parser(
         "suite", help="collect the dataset suite (random, medium, expert per game) from trained policies",
         description="Collects octax/<Game>/random-v0, medium-v0 and expert-v0 for the suite's games "
-                    f"({', '.join(suite.GAMES)}) from the PPO runs under --runs (examples/train_jax_ppo.py "
-                    "--save-at-evals --out-dir RUNS/<Game>; `make dataset-suite` trains and collects). "
+                    f"({', '.join(suite.GAMES)}) from the PPO agents of --runs (octax-gym train ppo --games ... "
+                    "--save-at-evals --out-dir RUNS; `make dataset-suite` trains and collects). "
                     "Each dataset's metadata names its policy; the params are copied beside its data. "
                     "Needs the datasets and train extras. See docs/datasets.md.")
     build.add_argument("--runs", type=Path, required=True, metavar="DIR",
-                       help="the training runs, one folder per game (DIR/Airplane/params.msgpack, ...)")
+                       help="the octax-gym train ppo --save-at-evals run of the games (DIR/agents/Airplane-seed0.msgpack, "
+                            "...), or one such run per game (DIR/Airplane/...)")
     build.add_argument("--games", nargs="+", default=list(suite.GAMES), metavar="GAME",
                        help=f"a subset of the suite's games (default: all of {' '.join(suite.GAMES)})")
     build.add_argument("--kinds", nargs="+", default=list(suite.KINDS), metavar="KIND",

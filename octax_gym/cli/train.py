@@ -72,6 +72,9 @@ def add_commands(commands: argparse._SubParsersAction) -> None:
                        help="decay the learning rate linearly to 0 (the paper: constant)")
     train.add_argument("--clip-value-loss", action=argparse.BooleanOptionalAction, default=None,
                        help="PPO: clip the value loss as CleanRL's Atari PPO does (default on)")
+    train.add_argument("--save-at-evals", action="store_true", default=None,
+                       help="keep each evaluation's agents too, as OUT/agents/<game>-seed<s>-step<N>.msgpack (the "
+                            "policies part way through training that `octax-gym dataset suite` picks from)")
     train.add_argument("--game-input", action=argparse.BooleanOptionalAction, default=None,
                        help="multitask: the game's one-hot joins the network's features (default on; off: the "
                             "screen alone tells the games apart)")
@@ -102,7 +105,7 @@ def config_from_args(args: argparse.Namespace):
     _import_train()
     from octax_gym.train import preset, resolve_games
 
-    given = {name: getattr(args, name) for name in (*SETTINGS, "anneal_lr", "clip_value_loss", "game_input")
+    given = {name: getattr(args, name) for name in (*SETTINGS, "anneal_lr", "clip_value_loss", "game_input", "save_at_evals")
              if getattr(args, name) is not None}
     if wrong := [name for name in given if name in NOT_OF[args.algorithm]]:
         flags = ", ".join("--" + n.replace("_", "-") for n in wrong)
@@ -136,7 +139,7 @@ def _cmd_train(args: argparse.Namespace) -> int:
 def _resumed(args: argparse.Namespace):
     """The config of the run in `--resume OUT` (its config.json); refuses other settings."""
     defaults = {"games": None, "preset": "cpu", "devices": None, "agent_map": None, "out_dir": None, "anneal_lr": None,
-                "clip_value_loss": None, "game_input": None, **{n: None for n in (*SETTINGS, *ENV_FLAGS)}}
+                "clip_value_loss": None, "game_input": None, "save_at_evals": None, **{n: None for n in (*SETTINGS, *ENV_FLAGS)}}
     if given := [name for name, default in defaults.items() if getattr(args, name) != default]:
         raise ValueError(f"--resume takes the run's own settings (OUT/config.json); drop "
                          f"{', '.join('--' + n.replace('_', '-') for n in given)}")

@@ -4,11 +4,12 @@ and `expert-v0`, each collected from a named policy whose params travel with the
     octax-gym dataset suite --runs runs/suite            # every game; see docs/datasets.md
     octax-gym dataset suite --runs runs/suite --games Airplane Flak --steps 20000
 
-The policies are PPO agents trained by the pure-JAX example with checkpoints at every evaluation
-(`examples/train_jax_ppo.py ... --save-at-evals --out-dir runs/suite/<Game>`; the exact commands are
-in docs/datasets.md and `make dataset-suite` runs them). From a game's training run:
+The policies are PPO agents trained by the package's trainer with every evaluation's agents kept
+(`octax-gym train ppo --games Airplane,Deep8,... --save-at-evals --out-dir runs/suite`: all the
+games' agents in one program; the exact command is in docs/datasets.md and `make dataset-suite`
+runs it). From a game's agent of that run (its first seed):
 
-- expert: the final params (`params.msgpack`), scored by the run's last evaluation;
+- expert: the final params (`agents/<Game>-seed<s>.msgpack`), scored by the run's last evaluation;
 - medium: of the checkpoints part way through training (neither the untrained network nor the
   final one), the one whose evaluation return is nearest a third of the way from the random
   policy's return to the expert's (D4RL's "medium": a policy part way through training, about a
@@ -36,7 +37,7 @@ from typing import Optional, Sequence
 
 from octax_gym.choices import UnknownOptionError
 
-# Games where the examples' PPO learns on two CPU cores (docs/results.md).
+# Games where the package's PPO learns on two CPU cores (docs/results.md).
 GAMES = ("Airplane", "Deep8", "Dodge", "Filter", "Flak", "Squash")
 KINDS = ("random", "medium", "expert")
 STEPS = 100_000  # per dataset
@@ -71,24 +72,39 @@ class PolicyCard:
                 "training_command": self.command}
 
 
-def pick_policies(run_dir) -> dict[str, PolicyCard]:
-    """The medium and expert policies of one training run of `examples/train_jax_ppo.py` made with
-    `--save-at-evals` (config.json, progress.csv, params.msgpack, checkpoints/params-step<N>.msgpack).
+def run_for(runs_dir, game: str) -> Path:
+    """The training run that holds `game`'s agent: `runs_dir/<game>/` when there is one (a run per
+    game), else `runs_dir` itself (one run of all the games, as `make dataset-suite` trains)."""
+    runs_dir = Path(runs_dir)
+    return runs_dir / game if (runs_dir / game).is_dir() else runs_dir
+
+
+def pick_policies(run_dir, game: str) -> dict[str, PolicyCard]:
+    """The medium and expert policies of `game` in one `octax-gym train ppo --save-at-evals` run
+    (config.json, progress.csv, agents/<game>-seed<s>.msgpack and agents/<game>-seed<s>-step<N>.msgpack,
+    s the run's first seed).
 
     Raises:
         FileNotFoundError: the run's files are missing (the message names the training command).
     """
     run_dir = Path(run_dir)
-    needed = [run_dir / "config.json", run_dir / "progress.csv", run_dir / "params.msgpack"]
-    missing = [str(p) for p in needed if not p.is_file()]
-    checkpoints = {int(m.group(1)): p for p in (run_dir / "checkpoints").glob("params-step*.msgpack")
-                   if (m := re.fullmatch(r"params-step(\d+)\.msgpack", p.name))}
-    if missing or not checkpoints:
-        raise FileNotFoundError(f"no suite training run in {run_dir} (missing: {', '.join(missing) or 'checkpoints/'}); "
-                                "train it with examples/train_jax_ppo.py --save-at-evals (docs/datasets.md)")
+    hint = (f"train it with `octax-gym train ppo --games {game} --save-at-evals --out-dir {run_dir}` "
+            "(docs/datasets.md; `make dataset-suite` trains every suite game)")
+    missing = [str(p) for p in (run_dir / "config.json", run_dir / "progress.csv") if not p.is_file()]
+    if missing:
+        raise FileNotFoundError(f"no suite training run in {run_dir} (missing: {', '.join(missing)}); {hint}")
     config = json.loads((run_dir / "config.json").read_text())
-    with open(run_dir / "progress.csv", newline="") as file:  # a one-seed run's rows (params.msgpack is its)
-        rows = [row for row in csv.DictReader(file) if int(row["seed"]) == int(config.get("seed", 0))]
+    seed = int(config.get("seed", 0))
+    name = f"{game}-seed{seed}"
+    final = run_dir / "agents" / f"{name}.msgpack"
+    checkpoints = {int(m.group(1)): p for p in (run_dir / "agents").glob(f"{name}-step*.msgpack")
+                   if (m := re.fullmatch(re.escape(name) + r"-step(\d+)\.msgpack", p.name))}
+    if game not in config.get("games", []) or not final.is_file() or not checkpoints:
+        raise FileNotFoundError(f"{run_dir} holds no {name} agent kept at every evaluation (games: "
+                                f"{', '.join(config.get('games', [])) or 'none'}; needs {final.name} and "
+                                f"{name}-step<N>.msgpack files from --save-at-evals); {hint}")
+    with open(run_dir / "progress.csv", newline="") as file:  # this agent's rows
+        rows = [row for row in csv.DictReader(file) if row["game"] == game and int(row["seed"]) == seed]
     evals = {int(row["step"]): float(row["eval_mean_return"]) for row in rows}
     random_return = float(rows[0]["random_mean_return"])
     final_step = max(evals)
@@ -96,17 +112,16 @@ def pick_policies(run_dir) -> dict[str, PolicyCard]:
     command = " ".join(config.get("command", []))
 
     def card(kind, path, step):
-        return PolicyCard(kind, config.get("algorithm", "PPO"), path, step, evals[step], int(config["eval_envs"]),
-                          random_return, command)
+        return PolicyCard(kind, config.get("algorithm", "ppo").upper(), path, step, evals[step],
+                          int(config["eval_envs"]), random_return, command)
 
     target = random_return + MEDIUM_FRACTION * (expert_return - random_return)
     candidates = [step for step in checkpoints if step in evals and 0 < step < final_step]  # part way through
     if not candidates:
-        raise FileNotFoundError(f"{run_dir}: no checkpoint between the start and the end of training with an "
+        raise FileNotFoundError(f"{run_dir}: no {name} agent between the start and the end of training with an "
                                 "evaluation in progress.csv")
     medium = min(candidates, key=lambda step: (abs(evals[step] - target), step))
-    return {"medium": card("medium", checkpoints[medium], medium),
-            "expert": card("expert", run_dir / "params.msgpack", final_step)}
+    return {"medium": card("medium", checkpoints[medium], medium), "expert": card("expert", final, final_step)}
 
 
 def _num_actions(game: str) -> int:
@@ -118,8 +133,8 @@ def _num_actions(game: str) -> int:
 
 def build_suite(runs_dir, games: Sequence[str] = GAMES, kinds: Sequence[str] = KINDS, *, steps: int = STEPS,
                 num_envs: int = ENVS, seed: int = 0, overwrite: bool = False, progress: bool = True) -> list:
-    """Collects the suite's datasets (every game x kind asked for) from the training runs under
-    `runs_dir/<Game>/`; returns the `CollectResult`s, in order.
+    """Collects the suite's datasets (every game x kind asked for) from the training run in
+    `runs_dir` (or a run per game, `runs_dir/<Game>/`: `run_for`); returns the `CollectResult`s, in order.
 
     Raises:
         UnknownOptionError: a game or kind outside the suite.
@@ -135,7 +150,7 @@ def build_suite(runs_dir, games: Sequence[str] = GAMES, kinds: Sequence[str] = K
 
     results = []
     for game in games:
-        cards = pick_policies(Path(runs_dir) / game) if set(kinds) - {"random"} else {}
+        cards = pick_policies(run_for(runs_dir, game), game) if set(kinds) - {"random"} else {}
         for kind in kinds:
             card: Optional[PolicyCard] = cards.get(kind)
             policy = "random" if card is None else jax_policy.sampling_policy(

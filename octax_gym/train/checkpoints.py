@@ -2,7 +2,9 @@
 
 * `save_agents`: `OUT/agents/<game>-seed<s>.msgpack` (`multitask-seed<s>`), one file per agent (flax serialization of
   `{"params": ...}`, what `octax_gym.jax_policy` and `octax-gym play --agent` read), rewritten at
-  every evaluation, so a run cut short keeps its last evaluated agents.
+  every evaluation, so a run cut short keeps its last evaluated agents; with `save_at_evals`
+  (`--save-at-evals`) each evaluation's agents are also kept as `<name>-step<N>.msgpack`, the
+  policies part way through training that the dataset suite picks its medium ones from.
 * `Checkpoints`: `OUT/resume/checkpoint.msgpack` (every agent's runner: params, optimizer and env
   states, keys as raw data; the loop's position: updates done, training seconds, the metric sums
   since the last evaluation) and `checkpoint.json` (the position, readable). Each is written to a
@@ -13,7 +15,7 @@ from __future__ import annotations
 
 import json
 from pathlib import Path
-from typing import Sequence
+from typing import Optional, Sequence
 
 import flax.serialization
 import jax
@@ -21,15 +23,20 @@ import jax.numpy as jnp
 import numpy as np
 
 
-def save_agents(out_dir: Path, names: Sequence[str], params, write: bool = True) -> list[Path]:
-    """Each agent's slice of `params` (leading agent axis) to `OUT/agents/<name>.msgpack`; every
-    process takes part (`host_values`), process 0 writes."""
+def save_agents(out_dir: Path, names: Sequence[str], params, write: bool = True,
+                step: Optional[int] = None) -> list[Path]:
+    """Each agent's slice of `params` (leading agent axis) to `OUT/agents/<name>.msgpack`, and
+    with `step` to `<name>-step<step>.msgpack` too; every process takes part (`host_values`),
+    process 0 writes."""
     params = host_values(params)
     paths = [Path(out_dir) / "agents" / f"{name}.msgpack" for name in names]
     if write:
         paths[0].parent.mkdir(parents=True, exist_ok=True)
         for i, path in enumerate(paths):
-            _replace(path, flax.serialization.to_bytes(jax.tree.map(lambda x: x[i], params)))
+            data = flax.serialization.to_bytes(jax.tree.map(lambda x: x[i], params))
+            _replace(path, data)
+            if step is not None:
+                _replace(path.with_name(f"{names[i]}-step{step}.msgpack"), data)
     return paths
 
 

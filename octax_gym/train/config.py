@@ -47,6 +47,7 @@ class TrainConfig:
     eval_max_steps: Optional[int] = None  # step cap per evaluation; None: the game's max_episode_steps
     eval_noop_max: int = 30  # evaluation episodes start after 0..30 no-ops (the ALE protocol), see evaluate.py
     checkpoint_every: int = 0  # updates between resumable checkpoints; 0: none
+    save_at_evals: bool = False  # keep every evaluation's agents too (agents/<name>-step<N>.msgpack): medium policies
     devices: str = ""  # "": one device; "all": every agent's envs split over every device
     agent_map: str = "auto"  # how agents share the program: vmap, map (one after another), auto (many.py)
     env_overrides: tuple = ()  # ((name, value), ...) of ENV_FLAGS, for every game

@@ -37,7 +37,8 @@ from octax_gym.train.parallel import DataParallel
 def train(config: TrainConfig, out_dir, *, roms: Optional[Sequence] = None, progress: bool = True,
           resume: bool = False) -> dict:
     """Trains every agent of `config`; writes config.json, progress.csv, learning_curve.png,
-    agents/<game>-seed<s>.msgpack and summary.json to `out_dir`. Returns the summary (paths, env
+    agents/<game>-seed<s>.msgpack (and, with `save_at_evals`, `<game>-seed<s>-step<N>.msgpack` at every
+    evaluation) and summary.json to `out_dir`. Returns the summary (paths, env
     steps/s of all agents together, the rows, the final params per agent, the final statistics).
 
     Args:
@@ -109,7 +110,8 @@ def train(config: TrainConfig, out_dir, *, roms: Optional[Sequence] = None, prog
         result = jax.device_get(evaluate(runner.params, fold(eval_keys, i), game_ids))
         rows = log.add(i, i * config.batch_size, time.perf_counter() - start, train_s, result, totals,
                        trainer.host_metrics(i))
-        save_agents(out_dir, config.agent_names, runner.params, write=writer)
+        save_agents(out_dir, config.agent_names, runner.params, write=writer,
+                    step=i * config.batch_size if config.save_at_evals else None)
         if writer:
             figure.draw(log.rows, config.game_ids, out_dir / "learning_curve.png", title)
         bar.set_postfix(eval=f"{np.mean([r['eval_mean_return'] for r in rows]):.2f}")

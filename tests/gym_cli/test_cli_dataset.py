@@ -108,7 +108,7 @@ def test_suite_collects_random_datasets_and_names_a_missing_training_run(tmp_pat
     # medium and expert need the game's training run: the error names the command that makes it
     assert cli.main(["dataset", "suite", "--runs", str(tmp_path / "runs"), "--games", "Flak", "--kinds", "expert",
                      "--steps", "40", "--no-progress", "--data-path", str(data)]) == 1
-    assert "examples/train_jax_ppo.py --save-at-evals" in capsys.readouterr().err
+    assert "octax-gym train ppo --games Flak --save-at-evals" in capsys.readouterr().err
     with pytest.raises(SystemExit):
         cli.main(["dataset", "suite", "--games", "Flak"])  # --runs is required
     assert cli.main(["dataset", "suite", "--runs", str(tmp_path), "--games", "Pong", "--no-progress"]) == 1

@@ -9,6 +9,6 @@ STEPS = (0, 64, 128, 192)  # the evaluations' steps of a TINY run
 
 # The runs several modules read (conftest's `trained` makes each once a session): four agents in one
 # program, and the lone run their (Deep8, seed 1) must equal, which test_resume also cuts and
-# resumes.
+# resumes and test_save_at_evals picks the suite's policies from.
 TOGETHER = ("--games", "Airplane,Deep8", "--num-seeds", "2")
-LONE = ("--games", "Deep8", "--seed", "1")
+LONE = ("--games", "Deep8", "--seed", "1", "--save-at-evals")
