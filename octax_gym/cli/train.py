@@ -5,6 +5,7 @@
     octax-gym train ppo --preset paper --games octax16 --num-seeds 3              # the paper's table, on a GPU
     octax-gym train ppo --resume runs/ppo                                           # a run cut short, continued
     octax-gym train multitask --games Airplane,Brix,Deep8,Filter --num-envs 64       # one agent for all four
+    octax-gym train bc --dataset octax/Flak/expert-v0 --num-seeds 2                  # offline, on a dataset
 
 Settings start from a preset (`--preset cpu`, the default, or `paper`) and each flag given
 overrides one. A setting no run can use, or one of another algorithm, is refused with its name.
@@ -18,11 +19,18 @@ import json
 from pathlib import Path
 
 TRAIN_HINT = "pip install 'octax-gym[train]'"
-ALGORITHMS = ("ppo", "pqn", "multitask")
+ALGORITHMS = ("ppo", "pqn", "multitask", "bc", "cql")
 PPO_ONLY = ("gae_lambda", "clip_eps", "clip_value_loss", "vf_coef", "ent_coef")
-PQN_ONLY = ("q_lambda", "epsilon_start", "epsilon_finish", "epsilon_fraction", "eval_epsilon")
+EXPLORATION = ("q_lambda", "epsilon_start", "epsilon_finish", "epsilon_fraction")
+PQN_ONLY = EXPLORATION + ("eval_epsilon",)  # eval_epsilon: CQL's too
 MULTITASK_ONLY = ("game_input",)
-NOT_OF = {"ppo": PQN_ONLY + MULTITASK_ONLY, "pqn": PPO_ONLY + MULTITASK_ONLY, "multitask": PQN_ONLY}
+OFFLINE_ONLY = ("dataset",)
+CQL_ONLY = ("cql_alpha", "target_every")
+NOT_OF = {"ppo": PQN_ONLY + MULTITASK_ONLY + OFFLINE_ONLY + CQL_ONLY,
+          "pqn": PPO_ONLY + MULTITASK_ONLY + OFFLINE_ONLY + CQL_ONLY,
+          "multitask": PQN_ONLY + OFFLINE_ONLY + CQL_ONLY,
+          "bc": PPO_ONLY + PQN_ONLY + MULTITASK_ONLY + CQL_ONLY,
+          "cql": PPO_ONLY + EXPLORATION + MULTITASK_ONLY}
 ENV_FLAGS = {"max_episode_steps": int, "frames_per_step": int, "repeat_action_probability": float, "noop_max": int}
 SETTINGS = {  # flag -> (type, help); each a TrainConfig field
     "seed": (int, "the first seed: seeds S..S+N-1 each train one agent per game"),
@@ -48,7 +56,10 @@ SETTINGS = {  # flag -> (type, help); each a TrainConfig field
     "epsilon_start": (float, "PQN: exploration rate of the first rollout"),
     "epsilon_finish": (float, "PQN: exploration rate after the decay"),
     "epsilon_fraction": (float, "PQN: fraction of the steps over which epsilon decays"),
-    "eval_epsilon": (float, "PQN: exploration rate of the sampled evaluation"),
+    "eval_epsilon": (float, "PQN, CQL: exploration rate of the sampled evaluation"),
+    "dataset": (str, "bc, cql: the Minari dataset id to train on (its game and env options are the run's)"),
+    "cql_alpha": (float, "CQL: weight of the conservative regulariser"),
+    "target_every": (int, "CQL: updates between copies of the target network"),
 }
 
 
@@ -56,11 +67,13 @@ def add_commands(commands: argparse._SubParsersAction) -> None:
     train = commands.add_parser(
         "train", help="train PPO or PQN agents in pure JAX: many games x seeds in one program (or multi-task)",
         description="Trains one agent per game and seed (not one agent for all games) in one jitted program, "
-                    "(multitask: one PPO agent per seed for all the games, lane i playing game i mod G), "
+                    "(multitask: one PPO agent per seed for all the games, lane i playing game i mod G; bc, cql: "
+                    "offline, from the Minari dataset --dataset), "
                     "writing OUT/progress.csv (a row per game, seed and evaluation), OUT/learning_curve.png, "
                     "OUT/agents/<game>-seed<s>.msgpack and OUT/summary.json. Needs the train extra: "
                     + TRAIN_HINT + ". See docs/training.md.")
-    train.add_argument("algorithm", choices=ALGORITHMS, metavar="ALGO", help="ppo, pqn or multitask")
+    train.add_argument("algorithm", choices=ALGORITHMS, metavar="ALGO",
+                       help="ppo, pqn, multitask, or bc and cql (offline, on --dataset)")
     train.add_argument("--games", "--game", dest="games", metavar="G[,G...]",
                        help="game ids, comma-separated, or octax16 (the paper's 16); default Brix")
     train.add_argument("--preset", default="cpu", metavar="NAME",
@@ -105,18 +118,28 @@ def config_from_args(args: argparse.Namespace):
     _import_train()
     from octax_gym.train import preset, resolve_games
 
-    given = {name: getattr(args, name) for name in (*SETTINGS, "anneal_lr", "clip_value_loss", "game_input", "save_at_evals")
-             if getattr(args, name) is not None}
+    switches = ("anneal_lr", "clip_value_loss", "game_input", "save_at_evals")
+    given = {name: getattr(args, name) for name in (*SETTINGS, *switches) if getattr(args, name) is not None}
     if wrong := [name for name in given if name in NOT_OF[args.algorithm]]:
         flags = ", ".join("--" + n.replace("_", "-") for n in wrong)
         owners = sorted({a for a, names in NOT_OF.items() if not set(wrong) & set(names)} - {args.algorithm})
         raise ValueError(f"{flags}: not a setting of {args.algorithm} (of {' and '.join(owners)})")
     if args.games is not None:
         given["games"] = resolve_games(args.games)
+    if args.algorithm in ("bc", "cql") and given.get("dataset"):  # the dataset's game and env options
+        from octax_gym.train.offline import dataset_env
+
+        game, dataset_overrides = dataset_env(given["dataset"])
+        if given.get("games", (game,)) != (game,):
+            raise ValueError(f"--games: {given['dataset']} is a dataset of {game}, not of {', '.join(given['games'])}")
+        given["games"], given["env_overrides"] = (game,), dataset_overrides
     for name in ("devices", "agent_map"):
         if getattr(args, name) is not None:
             given[name] = getattr(args, name)
     overrides = tuple((name, getattr(args, name)) for name in ENV_FLAGS if getattr(args, name) is not None)
+    if overrides and "dataset" in given:
+        raise ValueError(f"--{overrides[0][0].replace('_', '-')}: an offline run plays the env its dataset was "
+                         "collected in (its options are the dataset's)")
     if overrides:
         given["env_overrides"] = overrides
     return preset(args.preset, args.algorithm, **given)
@@ -139,7 +162,8 @@ def _cmd_train(args: argparse.Namespace) -> int:
 def _resumed(args: argparse.Namespace):
     """The config of the run in `--resume OUT` (its config.json); refuses other settings."""
     defaults = {"games": None, "preset": "cpu", "devices": None, "agent_map": None, "out_dir": None, "anneal_lr": None,
-                "clip_value_loss": None, "game_input": None, "save_at_evals": None, **{n: None for n in (*SETTINGS, *ENV_FLAGS)}}
+                "clip_value_loss": None, "game_input": None, "save_at_evals": None,
+                **{n: None for n in (*SETTINGS, *ENV_FLAGS)}}
     if given := [name for name, default in defaults.items() if getattr(args, name) != default]:
         raise ValueError(f"--resume takes the run's own settings (OUT/config.json); drop "
                          f"{', '.join('--' + n.replace('_', '-') for n in given)}")

@@ -1,4 +1,5 @@
-"""Training in pure JAX (flax, optax): the paper's PPO and PQN on octax games, many agents in one program.
+"""Training in pure JAX (flax, optax): the paper's PPO and PQN on octax games, many agents in one program;
+BC and CQL offline on a dataset.
 
     from octax_gym.train import TrainConfig, preset, train
     config = preset("cpu", "ppo", games=("Airplane", "Deep8"), num_seeds=2)
@@ -7,7 +8,8 @@
 or from the shell, `octax-gym train ppo --games Airplane,Deep8 --num-seeds 2 --out-dir runs/ppo`.
 One module per job: `networks` (the CNN, its PPO and PQN heads), `envs` (the run's games in one
 mix, each agent's lanes fixed to its game), `many` (the agent axis), `rollout` (runner, rollout,
-minibatch epochs), `ppo` and `pqn` (acting, targets, losses), `evaluate`, `log` (progress.csv),
+minibatch epochs), `ppo` and `pqn` (acting, targets, losses), `offline` (BC and CQL on a Minari
+dataset: a draw instead of a rollout), `evaluate`, `log` (progress.csv),
 `figure`, `report` (IQM and intervals), `checkpoints`, `parallel` (`--devices all`), `config`,
 `presets`, and `loop` (the one loop). Needs the `train` extra: pip install 'octax-gym[train]'.
 See docs/training.md.

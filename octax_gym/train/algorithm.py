@@ -22,12 +22,13 @@ class Trainer(NamedTuple):
     name: str  # "PPO", "PQN": titles and the progress bar
     network: Any  # the flax module
     init: Callable  # (key, game) -> runner
-    collect: Callable  # runner -> (runner, batch, metrics): one rollout and its targets
+    collect: Callable  # runner [, data] -> (runner, batch, metrics): one rollout (or dataset draw) and its targets
     learn: Callable  # (runner, batch) -> (runner, stats): the epochs of minibatch steps
     greedy: Callable  # (params, key, obs, game) -> actions: the largest logit or Q-value of the game's
     sampled: Callable  # (params, key, obs, game) -> actions: PPO's policy, PQN's eval epsilon-greedy
     metric_names: tuple[str, ...]  # per-update metrics, averaged between evaluations in the CSV
     host_metrics: Callable  # update index -> {name: value} for schedules (learning rate, epsilon)
+    data: Any = None  # what `collect` reads besides the runner, an argument of the compiled update (offline: the dataset)
 
 
 def make_trainer(config: TrainConfig, lanes: Lanes) -> Trainer:
@@ -38,4 +39,7 @@ def make_trainer(config: TrainConfig, lanes: Lanes) -> Trainer:
     if config.algorithm == "pqn":
         from octax_gym.train import pqn
         return pqn.make_trainer(config, lanes)
-    raise ValueError(f"algorithm must be one of ppo, pqn, multitask, got {config.algorithm!r}")
+    if config.algorithm in ("bc", "cql"):
+        from octax_gym.train import offline
+        return offline.make_trainer(config, lanes)
+    raise ValueError(f"algorithm must be one of ppo, pqn, multitask, bc, cql, got {config.algorithm!r}")

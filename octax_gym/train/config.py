@@ -14,7 +14,8 @@ from typing import Any, Optional, Union
 from octax_core.env.games import GameSpec
 from octax_core.env.mix import MIXES
 
-ALGORITHMS = ("ppo", "pqn", "multitask")  # multitask: one PPO agent per seed over all the games
+ALGORITHMS = ("ppo", "pqn", "multitask", "bc", "cql")  # multitask: one PPO agent per seed over all the games
+OFFLINE = ("bc", "cql")  # trained on a Minari dataset instead of a rollout (offline.py)
 DEVICES = ("", "all")
 AGENT_MAPS = ("auto", "vmap", "map")
 ENV_FLAGS = {"max_episode_steps": int, "frames_per_step": int, "repeat_action_probability": float,
@@ -65,6 +66,10 @@ class TrainConfig:
     eval_epsilon: float = 0.005  # the sampled evaluation of PQN: epsilon-greedy (the paper's code)
     # multitask's
     game_input: bool = True  # the game's one-hot joins the torso's features (else the screen alone tells)
+    # offline (bc, cql)
+    dataset: str = ""  # the Minari dataset id trained on; the run's game and env options are the dataset's
+    cql_alpha: float = 1.0  # weight of CQL's regulariser
+    target_every: int = 64  # CQL: updates between copies of the target network
 
     @property
     def batch_size(self) -> int:
@@ -152,6 +157,20 @@ class TrainConfig:
                 raise ValueError(f"{name} must be in [0, 1], got {getattr(self, name)}")
         for name, value in self.env_overrides:
             _choice("env override", name, tuple(ENV_FLAGS))
+        if self.algorithm in OFFLINE:
+            if not self.dataset:
+                raise ValueError(f"{self.algorithm} trains on a dataset: give its Minari id (--dataset, e.g. "
+                                 "octax/Flak/expert-v0)")
+            if len(self.games) != 1:
+                raise ValueError(f"{self.algorithm} trains on one dataset, of one game; got games "
+                                 f"{', '.join(self.game_ids)}")
+            if self.devices:
+                raise ValueError(f"devices must be '' for {self.algorithm} (one device: the dataset lies on it)")
+        elif self.dataset:
+            raise ValueError(f"dataset is a setting of bc and cql, not of {self.algorithm}")
+        _at_least("target_every", self.target_every, 1)
+        if not self.cql_alpha >= 0:
+            raise ValueError(f"cql_alpha must be >= 0, got {self.cql_alpha}")
         if self.multitask and self.num_envs % len(self.games):
             raise ValueError(f"multitask: num_envs = {self.num_envs} must be a multiple of the {len(self.games)} "
                              "games (lane i plays game i mod G, so each game gets as many lanes)")

@@ -87,11 +87,12 @@ def train(config: TrainConfig, out_dir, *, roms: Optional[Sequence] = None, prog
         parallel = DataParallel(config)
         runner = parallel.place(runner)
         eval_keys, game_ids = parallel.replicate(eval_keys), parallel.replicate(game_ids)
-        shardings = {"in_shardings": (parallel.shardings(runner),),
+        shardings = {"in_shardings": (parallel.shardings(runner), None),
                      "out_shardings": (parallel.shardings(runner), parallel.replicated)}
     compile_start = time.perf_counter()
-    update = jax.jit(over_agents(_update(trainer), num_agents, config.agent_map), donate_argnums=0, compiler_options=options,
-                     **shardings).lower(runner).compile()
+    # The update takes the trainer's data (offline: the dataset) as an argument shared by every agent.
+    update = jax.jit(over_agents(_update(trainer), num_agents, config.agent_map, in_axes=(0, None)), donate_argnums=0,
+                     compiler_options=options, **shardings).lower(runner, trainer.data).compile()
     print(f"compiled the {trainer.name} update in {time.perf_counter() - compile_start:.1f} s ({num_agents} "
           f"agent{'s' * (num_agents > 1)} x {config.num_envs} envs x {config.num_steps} steps, "
           f"{config.num_updates} updates)")
@@ -116,7 +117,7 @@ def train(config: TrainConfig, out_dir, *, roms: Optional[Sequence] = None, prog
             figure.draw(log.rows, config.game_ids, out_dir / "learning_curve.png", title)
         bar.set_postfix(eval=f"{np.mean([r['eval_mean_return'] for r in rows]):.2f}")
 
-    runner, train_s = _updates(config, update, runner, evaluated, checkpoints, start_at, bar)
+    runner, train_s = _updates(config, update, runner, trainer.data, evaluated, checkpoints, start_at, bar)
     bar.close()
     steps_per_s = config.num_updates * config.batch_size * num_agents / train_s
     summary = report.summarize(log.rows, config.game_ids, config.seeds)
@@ -132,9 +133,9 @@ def train(config: TrainConfig, out_dir, *, roms: Optional[Sequence] = None, prog
 
 
 def _update(trainer):
-    """One agent's update: its rollout and targets, then its epochs."""
-    def update(runner):
-        runner, batch, metrics = trainer.collect(runner)
+    """One agent's update: its rollout (or its draw from `data`, the trainer's) and targets, then its epochs."""
+    def update(runner, data):
+        runner, batch, metrics = trainer.collect(runner) if trainer.data is None else trainer.collect(runner, data)
         runner, stats = trainer.learn(runner, batch)
         return runner, {**metrics, **stats}
     return update
@@ -143,7 +144,7 @@ def _update(trainer):
 fold = jax.jit(jax.vmap(jax.random.fold_in, in_axes=(0, None)))
 
 
-def _updates(config: TrainConfig, update, runner, evaluated, checkpoints: Checkpoints, start_at, bar):
+def _updates(config: TrainConfig, update, runner, data, evaluated, checkpoints: Checkpoints, start_at, bar):
     """The updates, with `evaluated(i, runner, train_s, totals)` every `eval_every` steps and at
     both ends, and a checkpoint every `checkpoint_every` updates. Returns the runner and the
     seconds spent in updates."""
@@ -163,7 +164,7 @@ def _updates(config: TrainConfig, update, runner, evaluated, checkpoints: Checkp
         if config.checkpoint_every and i % config.checkpoint_every == 0 and i > 0 and not resumed_here:
             checkpoints.save(runner, {"update": i, "train_s": train_s, "totals": totals})
         t0 = time.perf_counter()
-        runner, metrics = update(runner)
+        runner, metrics = update(runner, data)
         metrics = jax.device_get(metrics)  # waits for the update: the timing covers all of it
         train_s += time.perf_counter() - t0
         for k, v in metrics.items():

@@ -24,9 +24,16 @@ PAPER = {
                 epsilon_fraction=0.1, eval_epsilon=0.005),
 }
 PAPER["multitask"] = PAPER["ppo"]  # the multi-task agent learns with PPO
+# Offline (not the paper's): an update draws 1,024 transitions and takes 8 Adam steps of 128 on them,
+# 2,000 steps in all (the batch and steps of the offline example it replaces); one setting for both presets.
+_OFFLINE = dict(total_steps=256_000, num_envs=128, num_steps=8, update_epochs=1, num_minibatches=8,
+                learning_rate=3e-4, anneal_lr=False, gamma=0.99, max_grad_norm=10.0, eval_every=64_000, eval_envs=32,
+                eval_epsilon=0.005, cql_alpha=1.0, target_every=64)
 _CPU_SCALE = dict(total_steps=655_360, num_envs=64, num_steps=32, num_minibatches=8, eval_every=65_536,
                   eval_envs=32)
 CPU = {algorithm: dict(settings, **_CPU_SCALE) for algorithm, settings in PAPER.items()}
+PAPER.update(bc=_OFFLINE, cql=_OFFLINE)
+CPU.update(bc=_OFFLINE, cql=_OFFLINE)
 PRESETS = {"paper": PAPER, "cpu": CPU}
 
 

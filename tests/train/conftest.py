@@ -5,7 +5,8 @@ the tiny runs takes well under a second), so every module trains with the one ti
 (the same programs, read back from JAX's persistent cache after their first compile) and a run
 that several checks read is trained once a session by `trained` (`tiny_run.TOGETHER` and `LONE`):
 the lone PPO run of (Deep8, seed 1) is the run a many-agent run's agent must equal, the run
-test_resume cuts and resumes and the one the dataset suite picks policies from. Tests read these folders and never write into them (they copy one to change it).
+test_resume cuts and resumes and the one the dataset suite picks policies from. Tests read these
+folders and never write into them (they copy one to change it).
 """
 
 from __future__ import annotations

@@ -51,11 +51,19 @@ def test_octax16_is_the_cores_list_of_the_papers_games():
     (["--games", "Airplane,BlackRainbow"], "a mix runs games of one platform"),
     (["--resume", "/nonexistent", "--seed", "2"], "--resume takes the run's own settings"),
     (["--resume", "/nonexistent"], "no config.json in /nonexistent"),
+    (["--dataset", "octax/Flak/expert-v0"], "--dataset: not a setting of ppo (of bc and cql)"),
 ])
 def test_bad_flags_are_refused_by_name(flags, message, capsys, tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)  # a refused run must write nothing, not even its default runs/ folder
     assert main(["train", "ppo", *flags, "--no-progress"]) == 1
     assert message in capsys.readouterr().err
+    assert not list(tmp_path.iterdir())
+
+
+def test_offline_training_needs_a_dataset(capsys, tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    assert main(["train", "bc", "--no-progress"]) == 1
+    assert "bc trains on a dataset: give its Minari id (--dataset" in capsys.readouterr().err
     assert not list(tmp_path.iterdir())
 
 
