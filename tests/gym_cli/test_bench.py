@@ -1,7 +1,10 @@
 """benchmarks/throughput.py and its door `octax-gym bench`: tiny runs, real output.
 
 Each run compiles a rollout, so N and the step counts are as small as they go: these check the
-plumbing and the output format, never a speed.
+plumbing and the output format, never a speed. The door runs the script's `main` in a child
+process (its output read from the file descriptors, capfd): a child's JAX start-up each, so the
+door itself is run a few times, and what the script prints and refuses is checked by calling the
+`main` the child calls, in this process (`door_main`).
 """
 
 from __future__ import annotations
@@ -25,6 +28,11 @@ import throughput  # noqa: E402
 TINY = ["--envs", "2", "--steps", "2", "--repeats", "1"]
 FIELDS = ["mode", "n", "devices", "steps", "sps", "ips", "state_bytes", "compile_s", "octax_sps",
           "octax_compile_s", "ratio", "device"]
+
+
+def door_main(argv: list[str]) -> int:
+    """What `octax-gym bench ARGV` runs in its child process, run here."""
+    return throughput.main(argv, prog="octax-gym bench", progress=True)
 
 
 def bench_lines(out: str) -> list[dict[str, str]]:
@@ -70,8 +78,8 @@ def check_line(fields: dict[str, str], mode: str, n: int, steps: int) -> None:
 
 
 @pytest.mark.parametrize("mode", ["machine", "env", "gym"])
-def test_cli_bench_prints_one_parseable_line_per_n_and_the_bar_on_stderr(mode, octax_rom_dir, capsys):
-    assert cli.main(["bench", "--quick", "--no-octax", "--mode", mode, *TINY]) == 0
+def test_bench_prints_one_parseable_line_per_n_and_the_bar_on_stderr(mode, octax_rom_dir, capsys):
+    assert door_main(["--quick", "--no-octax", "--mode", mode, *TINY]) == 0
     out, err = capsys.readouterr()
     (fields,) = bench_lines(out)  # explicit --envs and --repeats win over --quick
     check_line(fields, mode, 2, 2)
@@ -81,9 +89,17 @@ def test_cli_bench_prints_one_parseable_line_per_n_and_the_bar_on_stderr(mode, o
     assert "run 1/1" not in out
 
 
+def test_the_door_runs_the_script_with_its_bar_in_a_child(octax_rom_dir, capfd):
+    assert cli.main(["bench", "--quick", "--no-octax", "--mode", "machine", *TINY]) == 0
+    out, err = capfd.readouterr()
+    (fields,) = bench_lines(out)
+    check_line(fields, "machine", 2, 2)
+    assert "run 1/1" in err and "BENCH" not in err and "run 1/1" not in out
+
+
 @pytest.mark.parametrize("backend", ["jax", "torch"])
 def test_gym_mode_backends(backend, capsys):
-    assert cli.main(["bench", "--no-octax", "--mode", "gym", "--backend", backend, "--no-progress", *TINY]) == 0
+    assert door_main(["--no-octax", "--mode", "gym", "--backend", backend, "--no-progress", *TINY]) == 0
     out, err = capsys.readouterr()
     (fields,) = bench_lines(out)
     check_line(fields, "gym", 2, 2)
@@ -93,9 +109,9 @@ def test_gym_mode_backends(backend, capsys):
 
 def test_octax_comparison_and_jsonl(tmp_path, capsys):
     jsonl = tmp_path / "bench.jsonl"
-    argv = ["bench", "--mode", "gym", "--envs", "2,3", "--steps", "2", "--repeats", "1", "--octax-max-envs", "2",
+    argv = ["--mode", "gym", "--envs", "2,3", "--steps", "2", "--repeats", "1", "--octax-max-envs", "2",
             "--jsonl", str(jsonl), "--no-progress"]
-    assert cli.main(argv) == 0
+    assert door_main(argv) == 0
     lines = bench_lines(capsys.readouterr().out)
     assert [line["n"] for line in lines] == ["2", "3"]
     assert int(lines[0]["octax_sps"]) > 0 and float(lines[0]["ratio"]) > 0  # same work: 44 instructions a step
@@ -106,7 +122,7 @@ def test_octax_comparison_and_jsonl(tmp_path, capsys):
 
 def test_missing_octax_is_a_one_line_note_not_a_crash(monkeypatch, capsys):
     monkeypatch.setitem(sys.modules, "octax", None)  # `import octax` now raises ImportError
-    assert cli.main(["bench", "--mode", "machine", "--no-progress", *TINY]) == 0
+    assert door_main(["--mode", "machine", "--no-progress", *TINY]) == 0
     out = capsys.readouterr().out
     notes = [line for line in out.splitlines() if "octax comparison skipped" in line]
     assert len(notes) == 1 and "pip install 'octax-gym[dev]'" in notes[0]
@@ -140,39 +156,36 @@ def test_quick_fills_only_what_is_not_given():
 ])
 def test_bad_options_are_usage_errors(argv, message, capsys):
     with pytest.raises(SystemExit) as exc:
-        cli.main(["bench", *argv])
+        door_main(argv)
     assert exc.value.code == 2 and message in capsys.readouterr().err
 
 
+def test_the_door_passes_on_a_usage_error_under_its_own_name(capfd):
+    assert cli.main(["bench", "--key", "16"]) == 2
+    assert "octax-gym bench: error: --key must be in -1..15, got 16" in capfd.readouterr().err
+
+
 def test_a_key_pong_has_no_action_for_fails_before_compiling(capsys):
-    assert cli.main(["bench", "--mode", "env", "--key", "5", *TINY]) == 1
+    assert door_main(["--mode", "env", "--key", "5", *TINY]) == 1
     err = capsys.readouterr().err
     assert "octax-gym bench: error: Pong has no action for key 5 (keys [1, 4])" in err
 
 
 def test_a_missing_rom_is_an_error(tmp_path, capsys):
-    assert cli.main(["bench", "--rom", str(tmp_path / "nothing.ch8"), *TINY]) == 1
+    assert door_main(["--rom", str(tmp_path / "nothing.ch8"), *TINY]) == 1
     assert "octax-gym bench: error:" in capsys.readouterr().err
 
 
-def test_devices_after_jax_has_computed_is_a_clear_error(capsys):
-    jax.numpy.zeros(1).block_until_ready()  # this process's device count is now fixed
-    if jax.device_count() == 2:
-        pytest.fail("the test process already has 2 devices; this test needs 1")
-    assert cli.main(["bench", "--devices", "2", "--no-octax", *TINY]) == 1
-    assert "already run a computation" in capsys.readouterr().err
-
-
-def test_cli_devices_splits_the_batch_although_octax_gym_imports_jax():
-    # `python -m octax_gym` imports jax (via the octax_gym package) before parsing --devices.
-    result = subprocess.run(
-        [sys.executable, "-m", "octax_gym", "bench", "--devices", "2", "--envs", "4", "--steps", "2",
-         "--repeats", "1", "--no-octax", "--no-progress"],
-        capture_output=True, text=True, timeout=300, cwd=REPO, check=False)
-    assert result.returncode == 0, result.stderr
-    (fields,) = bench_lines(result.stdout)
+def test_devices_split_the_batch_although_this_process_has_computed(capfd):
+    # The script's JAX is its child process's own: `--devices` works even after this process (which
+    # imported octax_gym, and jax with it) has fixed its own device count by computing.
+    jax.numpy.zeros(1).block_until_ready()
+    assert cli.main(["bench", "--devices", "2", "--envs", "4", "--steps", "2", "--repeats", "1", "--no-octax",
+                     "--no-progress"]) == 0
+    out = capfd.readouterr().out
+    (fields,) = bench_lines(out)
     assert fields["devices"] == "2" and fields["mode"] == "machine"
-    assert "devices=2" in result.stdout.splitlines()[0]
+    assert "devices=2" in out.splitlines()[0]
 
 
 def test_thin_script_still_runs_without_a_progress_bar():
