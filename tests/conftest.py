@@ -38,6 +38,14 @@ jax.config.update("jax_compilation_cache_dir", _JAX_CACHE)
 jax.config.update("jax_persistent_cache_min_compile_time_secs",
                   float(os.environ["JAX_PERSISTENT_CACHE_MIN_COMPILE_TIME_SECS"]))
 
+# Where a cold run's time goes: with OCTAX_COMPILE_LOG=FILE every XLA compile (or persistent-cache
+# read), trace and lowering is appended to FILE as a tab-separated line (test, event, function,
+# seconds); `python tests/compile_log.py FILE` sums it by file, test and function.
+if os.environ.get("OCTAX_COMPILE_LOG"):
+    from compile_log import record_compiles
+
+    record_compiles(os.environ["OCTAX_COMPILE_LOG"])
+
 
 # Longest files first: pytest-xdist hands each worker whole files (`--dist loadfile`) in collection
 # order, so a long file collected last keeps one worker busy while the other waits. Each run records
