@@ -1,0 +1,6 @@
+"""Generated games: procedural families written in Octo. See docs/generate.md.
+
+    families   the templates and their parameter ranges (FAMILIES, get_family)
+    sample     parameters drawn from a seed;  render  a variant's Octo source
+    build      the source assembled, and the GameSpec every variant of every family shares
+"""
