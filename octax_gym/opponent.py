@@ -10,9 +10,11 @@ TorchRL and any one-agent Gymnasium code train on unchanged.
 `OctaxVectorEnv`; it turns the env into the two-player env (`octax_core.make_multi`) seen from one
 seat, run by the same compiled step as every other env (`octax_gym.compiled_step`):
 
-* opponents: "noop" (holds no key), "random" (uniform over the actions open to it now: on a
-  turn-based game's other turns that is no-op alone), "scripted" (the game's own bot,
-  `Seats.scripted_policy`, which reads the machine state), all three inside the jitted step; or
+* opponents: the core's table of players (`octax_core.env.players`), inside the jitted step:
+  "noop" (holds no key), "random" (uniform over the actions open to it now: on a turn-based
+  game's other turns that is no-op alone), "scripted" (the game's own bot,
+  `Seats.scripted_policy`, which reads the machine state) and "eps<p>", e.g. "eps0.25" (the
+  scripted bot with a random action with probability p: the ladder's rungs); or
   a function obs -> action, called on the host before each step with the opponent's own
   observation (its player plane included): one observation (F+1, H, W) -> one int for
   `OctaxEnv`, a batch (num_envs, F+1, H, W) -> num_envs ints for `OctaxVectorEnv`, in the env's
@@ -45,10 +47,12 @@ from typing import Any, Callable, Optional
 import jax
 import jax.numpy as jnp
 
+from octax_core.env import players
 from octax_core.env.games import GameSpec, list_games
 from octax_gym.choices import UnknownOptionError
 
-OPPONENTS = ("random", "noop", "scripted")  # the opponents that run inside the jitted step
+OPPONENTS = tuple(players.PLAYERS)  # the opponents that run inside the jitted step (and "eps<p>")
+EPS_HINT = "'eps<p>' (the scripted player, a random action with probability p)"
 SEATS = (0, 1)
 OPPONENT_STREAM = 0x0990  # folded into a step's key for the random opponent's draw
 
@@ -60,7 +64,7 @@ class OpponentRequiredError(ValueError):
 @dataclasses.dataclass(frozen=True)
 class View:
     """What the compiled step needs of a single-agent view: the learner's seat and the kind of
-    opponent ("random", "noop", "scripted", or "callable": actions come from the host)."""
+    opponent (a name of the players' table, or "callable": actions come from the host)."""
 
     seat: int
     opponent: str
@@ -98,31 +102,29 @@ def resolve(opponent: Any, seat: Any, spec: GameSpec) -> tuple[Optional[View], O
     seat = int(seat)
     if callable(opponent):
         return View(seat, "callable"), opponent
-    if not isinstance(opponent, str) or opponent not in OPPONENTS:
-        raise UnknownOptionError("opponent", opponent, OPPONENTS, "or a function obs -> action")
-    if opponent == "scripted" and spec.seats.scripted_policy is None:
-        raise ValueError(f"{spec.id} has no scripted policy (Seats.scripted_policy); opponents: 'random', "
-                         f"'noop' or a function obs -> action")
-    return View(seat, opponent), None
+    eps = players.eps_of(opponent)
+    if not isinstance(opponent, str) or (opponent not in OPPONENTS and eps is None):
+        raise UnknownOptionError("opponent", opponent, OPPONENTS, f"{EPS_HINT}, or a function obs -> action")
+    if (opponent == "scripted" or eps is not None) and spec.seats.scripted_policy is None:
+        raise ValueError(f"{spec.id} has no scripted policy (Seats.scripted_policy), so no {opponent!r}; "
+                         f"opponents: 'random', 'noop' or a function obs -> action")
+    return View(seat, players.check_player(opponent, spec)), None
 
 
 def actions_of_both(env, view: View, step_keys: jax.Array, state, learner: jax.Array,
                     given: Optional[jax.Array]) -> jax.Array:
     """Traced: the (num_envs, 2) actions of a step, the learner's in its seat's column and the
-    opponent's in the other, computed here from the machine state (scripted), the step keys
-    (random) or given by the host (a function's)."""
-    other = view.other
+    opponent's in the other, given by the host (a function's) or played here by the table's
+    player from the machine state, the actions open to it now and its own draw of the step keys.
+    The table's players read no observation (the opponent's is not made before its move): None."""
     if view.opponent == "callable":
         theirs = given
-    elif view.opponent == "noop":
-        theirs = jnp.zeros_like(learner)
-    elif view.opponent == "scripted":
-        policy = env.seats.scripted_policy
-        theirs = jax.vmap(lambda machine: jnp.asarray(policy(machine, other), jnp.int32))(state.machine)
-    else:  # random: uniform over the actions open to the opponent now
-        open_now = jax.vmap(env.legal_action_mask)(state)[:, other]
+    else:
+        player = players.make_player(view.opponent, env.spec)
+        open_now = jax.vmap(env.legal_action_mask)(state)[:, view.other]
         keys = jax.vmap(lambda key: jax.random.fold_in(key, OPPONENT_STREAM))(step_keys)
-        theirs = jax.vmap(lambda key, mask: jax.random.categorical(key, jnp.where(mask, 0.0, -jnp.inf)))(keys, open_now)
+        theirs = jax.vmap(player, in_axes=(None, 0, None, 0, None, 0))(None, keys, None, state, jnp.int32(view.other),
+                                                                       open_now)
     theirs = jnp.asarray(theirs, jnp.int32)
     return jnp.stack([learner, theirs] if view.seat == 0 else [theirs, learner], axis=1)
 

@@ -6,14 +6,21 @@ collect`, and `octax-gym trace`'s --policy choices) all take a policy the same w
 trained agent. A policy maps the batched observation, (num_envs, frames_per_step, H, W), to one
 action per env, ints in 0..num_actions-1 of shape (num_envs,). The built-in ones ignore the
 observation, and a seeded one gives the same actions for the same seed in every caller.
+
+The built-in ones are the core's table of players (`octax_core.env.players`, which also fills the
+seats of two-player games), its `SEATLESS` ones: the same traced function, here batched over the
+envs and fed one key per step from `seed`'s chain.
 """
 
 from __future__ import annotations
 
 from typing import Any, Callable, Union
 
+import jax
+import jax.numpy as jnp
 import numpy as np
 
+from octax_core.env import players
 from octax_gym.choices import check_choice
 
 Policy = Union[None, str, Callable[[Any], Any]]
@@ -23,21 +30,26 @@ DEFAULT = "random"  # what None means
 FUNCTION_HINT = "or a function from a batch of observations to a batch of actions"
 
 
-def _random(num_envs: int, num_actions: int, seed: int) -> Act:
-    generator = np.random.default_rng(seed)
-    return lambda obs: generator.integers(0, num_actions, num_envs)
+def _table_policy(name: str) -> Callable[[int, int, int], Act]:
+    """The table's player `name` for a batch of one-player envs: every action open, one key a step."""
+    player = players.make_player(name, None)
+    batched = jax.jit(jax.vmap(player, in_axes=(None, 0, None, None, None, None)))
+
+    def build(num_envs: int, num_actions: int, seed: int) -> Act:
+        legal = jnp.ones(num_actions, jnp.bool_)
+        chain = [jax.random.key(seed)]
+
+        def act(obs):
+            chain[0], draw = jax.random.split(chain[0])
+            actions = batched(None, jax.random.split(draw, num_envs), None, None, jnp.int32(0), legal)
+            return np.asarray(actions, np.int64)
+        return act
+    return build
 
 
-def _noop(num_envs: int, num_actions: int, seed: int) -> Act:
-    actions = np.zeros(num_envs, np.int64)
-    return lambda obs: actions
-
-
-# name -> (num_envs, num_actions, seed) -> policy
-POLICIES: dict[str, Callable[[int, int, int], Act]] = {
-    "random": _random,  # uniform over the actions, from numpy's generator seeded with `seed`
-    "noop": _noop,  # action 0 (no key) in every env
-}
+# name -> (num_envs, num_actions, seed) -> policy: "random" (uniform over the actions) and "noop"
+# (action 0, no key), the core table's players that need no seat.
+POLICIES: dict[str, Callable[[int, int, int], Act]] = {name: _table_policy(name) for name in players.SEATLESS}
 
 
 def check_policy(policy: Policy) -> Policy:

@@ -20,9 +20,9 @@ Batch with `jax.vmap` (params unbatched: `in_axes=(None, 0, 0, 0, 0, 0)`).
 
 The table (`PLAYERS`, and `eps<p>` names):
 
-- "noop": action 0, no key held.
 - "random": uniform over the seat's legal actions (on a turn-based game's other turns that is
   no-op alone).
+- "noop": action 0, no key held.
 - "scripted": the game's own bot, `Seats.scripted_policy` (two-player games that have one).
 - "eps<p>", e.g. "eps0.25": the scripted action, replaced with probability p by a uniform legal
   random one; eps0 is "scripted", eps1 is "random". The issue-41 measurements showed why these
@@ -82,19 +82,21 @@ def eps_scripted(spec: GameSpec, eps: float) -> Player:
     return act
 
 
-# name -> spec -> player: the table every layer reads (`eps<p>` names are `eps_scripted`'s).
-PLAYERS: dict[str, Callable[[GameSpec], Player]] = {
-    "noop": lambda spec: noop,
+# name -> spec -> player: the table every layer reads (`eps<p>` names are `eps_scripted`'s):
+# octax_gym's policies (one-player envs), its opponents, the web player's seats, the tracer, the ladder.
+PLAYERS: dict[str, Callable[[Optional[GameSpec]], Player]] = {
     "random": lambda spec: uniform,
+    "noop": lambda spec: noop,
     "scripted": scripted,
 }
+SEATLESS = ("random", "noop")  # the players that read no seat, state or observation: any env's, one-player too
 
 
 def player_names(spec: Optional[GameSpec] = None) -> tuple[str, ...]:
     """The table's names open to a game (all three where `spec` is None); "eps<p>" names are open
     wherever "scripted" is."""
     if spec is not None and (spec.seats is None or spec.seats.scripted_policy is None):
-        return ("noop", "random")
+        return SEATLESS
     return tuple(PLAYERS)
 
 
@@ -126,8 +128,9 @@ def check_player(name: Any, spec: Optional[GameSpec] = None) -> str:
                      + (hint if "scripted" in valid else ""))
 
 
-def make_player(name: str, spec: GameSpec) -> Player:
-    """The table's player `name` ("noop", "random", "scripted", "eps<p>") for a game.
+def make_player(name: str, spec: Optional[GameSpec]) -> Player:
+    """The table's player `name` ("random", "noop", "scripted", "eps<p>") for a game (`spec` None:
+    any env's, for the `SEATLESS` players).
 
     Raises:
         ValueError: as `check_player`.
@@ -137,7 +140,8 @@ def make_player(name: str, spec: GameSpec) -> Player:
     return eps_scripted(spec, eps) if eps is not None else PLAYERS[name](spec)
 
 
-def _scripted_policy(spec: GameSpec, name: str):
-    if spec.seats is None or spec.seats.scripted_policy is None:
+def _scripted_policy(spec: Optional[GameSpec], name: str):
+    if spec is None or spec.seats is None or spec.seats.scripted_policy is None:
         check_player(name, spec)  # raises, naming the game's players
+        raise ValueError(f"the {name!r} player is a game's own: pass its GameSpec")
     return spec.seats.scripted_policy

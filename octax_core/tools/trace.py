@@ -27,10 +27,11 @@ import numpy as np
 from octax_core.emulator.state import shown
 from octax_core.env.environment import Env, EnvParams, make
 from octax_core.env.games import GameSpec, get_spec
+from octax_core.env.players import SEATLESS, make_player
 from octax_core.validate import check_int
 from octax_core.emulator.rom import Rom
 
-POLICIES = ("random", "noop")
+POLICIES = SEATLESS  # the table's players that need no seat (octax_core.env.players): "random", "noop"
 DEFAULT_STALL_STEPS = 30  # 2 s at 4 frames a step; the suite's longest pause before a serve is 24 (Pong)
 RAW_MAX_EPISODE_STEPS = 2**30  # a raw ROM has no episode bound of its own
 
@@ -115,7 +116,8 @@ def record_trace(game: str | GameSpec, *, steps: int, num_envs: int = 8, policy:
         game: a registered id or a `GameSpec` (`raw_rom_spec(path)` for a bare ROM).
         steps: env steps per env, >= 1.
         num_envs: envs played side by side, >= 1; each restarts when its episode ends.
-        policy: "random" (uniform over the spec's actions) or "noop" (no key ever held).
+        policy: "random" (uniform over the spec's actions) or "noop" (no key ever held): the
+            players of `octax_core.env.players`.
         seed: everything random (resets, CXNN, the policy) comes from it: same seed, same trace.
         blind: ignore the spec's reward and termination (what a raw ROM gets).
         rom: an explicit ROM path, as `make` takes it (else the ROM store finds it by SHA-1).
@@ -167,24 +169,27 @@ def _load(spec: GameSpec, rom: str | None) -> tuple[Env, EnvParams, bytes]:
 def _rollout(env: Env, policy: str, stall_steps: int):
     """One jitted program: vmap over envs of a scan over steps, resetting envs whose episode ended."""
 
+    player = make_player(policy, None)
+    legal = jnp.ones(env.num_actions, jnp.bool_)
+
     def play(keys, params):  # keys: (steps + 1,) for one env
-        _, state = env.reset(keys[0], params)
+        obs, state = env.reset(keys[0], params)
 
         def step(carry, key):
-            state, still = carry
+            obs, state, still = carry
             action_key, step_key, reset_key = jax.random.split(key, 3)
-            action = jax.random.randint(action_key, (), 0, env.num_actions) if policy == "random" else 0
+            action = player(None, action_key, obs, state, jnp.int32(0), legal)
             obs, after, reward, terminated, truncated, _ = env.step(step_key, state, action, params)
             still = jnp.where(_unchanged(state.machine, after.machine), still + 1, 0)
             if stall_steps:
                 terminated = terminated | (still >= stall_steps)
             ended = terminated | truncated  # the stall rule is the trace's own, so not `after.done`
-            _, state = env.autoreset(reset_key, ended, obs, after, params)
+            obs, state = env.autoreset(reset_key, ended, obs, after, params)
             out = (after.machine.V, after.machine.pc, reward, terminated, truncated & ~terminated)
-            return (state, jnp.where(ended, 0, still)), out
+            return (obs, state, jnp.where(ended, 0, still)), out
 
         # Every reset gives the same registers (it only reseeds the random state): return them once.
-        return state.machine.V, jax.lax.scan(step, (state, jnp.int32(0)), keys[1:])[1]
+        return state.machine.V, jax.lax.scan(step, (obs, state, jnp.int32(0)), keys[1:])[1]
 
     return jax.jit(jax.vmap(play, in_axes=(0, None)), compiler_options=env.compiler_options)
 

@@ -33,7 +33,10 @@ from typing import Any, Optional
 MAX_MESSAGE_BYTES = 1024      # the longest valid message is under 100 bytes
 MAX_SEQ = 2**53 - 1           # JavaScript's largest exact integer
 SPEEDS = (1.0, 0.5, 0.25, 0.125)
-PLAYERS = ("human", "agent", "scripted", "random")
+# The page's players: a human, the agent file, and the core's table of players
+# (`octax_core.env.players`) the page offers: the game's bot and uniform random.
+TABLE_PLAYERS = ("scripted", "random")
+PLAYERS = ("human", "agent", *TABLE_PLAYERS)
 MESSAGE_KEYS = {
     "key": {"type", "key", "down", "seq"},
     "pause": {"type", "paused"},

@@ -20,13 +20,16 @@ import time
 from typing import Any, Callable, Optional
 
 import jax
+import jax.numpy as jnp
 import numpy as np
 
 from octax_core.env.games import list_games
+from octax_core.env.players import make_player
 from octax_gym import render
 from octax_gym.compiled_step import MAX_SEED
 from octax_gym.game_names import resolve_spec
 from octax_gym.multi_vector import MultiAgentVectorEnv
+from octax_gym.play.protocol import TABLE_PLAYERS
 from octax_gym.vector import FRAMES_PER_SECOND, OctaxVectorEnv
 
 # Octo's keyboard layout: the keys of a 4x4 block on a QWERTY keyboard, row by row, are the
@@ -112,22 +115,22 @@ class Session:
         self.episode = -1
         self.held: list[int] = []          # CHIP-8 keys held, the latest pressed last
         self.seq = 0                       # the last key event seen
-        self.rng = np.random.default_rng(seed)
+        self.draws = jax.random.key(seed)  # the table players' draws (random), one a step
         self.history: collections.deque[StepRecord] = collections.deque(maxlen=HISTORY)
         self.step_times: collections.deque[float] = collections.deque(maxlen=151)
         self.step_seconds: collections.deque[float] = collections.deque(maxlen=150)
         # Seconds from a key press reaching the server to the end of the step that played it.
         self.key_wait: collections.deque[float] = collections.deque(maxlen=1000)
         self._pressed_at: Optional[float] = None
-        self._scripted = {}
+        self._table = {}                   # a table player's name -> its compiled action
         self.obs = self.info = None
         self.done = False
         self.human_only = True             # every step of this episode was played by humans alone
         self._warm_up()
         self.reset()
-        if self.scripted_available:         # compiled now, not in the middle of a game
-            for seat in range(self.seats):
-                self._scripted_action(seat)
+        for name in TABLE_PLAYERS:          # compiled now, not in the middle of a game
+            if name in self.available_players():
+                self._table_action(name, 0)
 
     def _warm_up(self) -> None:
         """Compiles the env's reset, step and masked reset now, not in the middle of a game."""
@@ -244,11 +247,8 @@ class Session:
             action = self.human_action(seat)
         elif player == "agent":
             action = int(self.agent(self.seat_observation(seat)))
-        elif player == "scripted":
-            action = self._scripted_action(seat)
         else:
-            legal = np.flatnonzero(self.legal_mask(seat))
-            action = int(self.rng.choice(legal)) if len(legal) else 0
+            action = self._table_action(player, seat)
         if not 0 <= action < self.num_actions or not self.legal_mask(seat)[action]:
             action = 0  # a key the game does not take now (a turn-based game's other turn) holds none
         return action
@@ -262,11 +262,17 @@ class Session:
         """What an agent in `seat` sees: (F, H, W) in a one-player game, (F + 1, H, W) in a two-player one."""
         return np.asarray(self.obs[0, seat] if self.two_player else self.obs[0])
 
-    def _scripted_action(self, seat: int) -> int:
-        if seat not in self._scripted:
-            policy = self.spec.seats.scripted_policy
-            self._scripted[seat] = jax.jit(jax.vmap(lambda machine: policy(machine, seat)))
-        return int(self._scripted[seat](self.env.state.machine)[0])
+    def _table_action(self, name: str, seat: int) -> int:
+        """The action of the table's player `name` (`octax_core.env.players`) in `seat`, from the
+        env's state, the seat's observation and legal actions, and the session's next key."""
+        if name not in self._table:
+            player = make_player(name, self.spec if self.two_player else None)
+            self._table[name] = jax.jit(jax.vmap(player, in_axes=(None, 0, 0, 0, None, 0)))
+        self.draws, draw = jax.random.split(self.draws)
+        obs = self.obs[:, seat] if self.two_player else self.obs
+        action = self._table[name](None, draw[None], jnp.asarray(obs), self.env.state, jnp.int32(seat),
+                                   jnp.asarray(self.legal_mask(seat))[None])
+        return int(action[0])
 
     def _finish(self, cut: bool) -> None:
         if self.recorder is not None and self.obs is not None:
