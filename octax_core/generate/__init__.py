@@ -1,6 +1,8 @@
-"""Generated games: procedural families written in Octo. See docs/generate.md.
+"""Generated games: procedural families written in Octo, and the checks that keep the playable
+ones. See docs/generate.md.
 
     families   the templates and their parameter ranges (FAMILIES, get_family)
     sample     parameters drawn from a seed;  render  a variant's Octo source
     build      the source assembled, and the GameSpec every variant of every family shares
+    filters    the checks every candidate of a round passes, run as one batch (a mix)
 """

@@ -285,8 +285,10 @@ CATCHER = Family(
     name="catcher",
     description="Things fall; move the basket (keys 4 left, 6 right) under them: +1 for each caught; "
                 "one that lands beside it costs a life; the game ends with the last life or at 200.",
-    action_keys=(4, 6), ranges=_FALLER_RANGES,
-    sprites={"ship": ((4, 8), (2, 4)), "thing": ((2, 6), (2, 5))},
+    # fewer things and a faster, wider basket than the dodger's ship: catching every thing of
+    # four, scattered over 64 columns, is out of any player's reach
+    action_keys=(4, 6), ranges={"things": (1, 2), "fall": (1, 3), "step": (2, 4), "lives": (1, 5)},
+    sprites={"ship": ((6, 8), (2, 4)), "thing": ((2, 6), (2, 5))},
     split="fall", held_out=(3,),
     derive=_fallers_fields("point", "hit", "Catcher", "catcher"), template=_FALLERS)
 
@@ -488,7 +490,7 @@ return
 def _paddle_fields(p: dict) -> dict:
     pad_y = 32 - p["paddle_h"]
     pad_max = (64 - p["paddle_w"]) // p["step"] * p["step"]
-    ball_x_max = 64 - p["ball_w"]
+    ball_x_max = pad_max + p["paddle_w"] - p["ball_w"]  # the right wall: where the paddle's right edge reaches
     return dict(pad_y=pad_y, pad_max=pad_max, pad_start=pad_max // 2 // p["step"] * p["step"],
                 ball_y_max=pad_y - p["ball_h"], ball_x_max=ball_x_max, ball_last=p["ball_w"] - 1,
                 pad_last=p["paddle_w"] - 1, reach=p["ball_w"] + p["paddle_w"] - 1,
@@ -501,8 +503,10 @@ PADDLE = Family(
     name="paddle",
     description="A ball bounces off the walls; move the paddle (keys 4 left, 6 right) under it: +1 for "
                 "each return; a miss costs a life; the game ends with the last life or at 200.",
-    action_keys=(4, 6), ranges={"speed_x": (1, 3), "speed_y": (1, 2), "step": (1, 3), "lives": (1, 5)},
-    sprites={"paddle": ((5, 8), (1, 2)), "ball": ((1, 3), (1, 3))},
+    # the paddle moves at least as fast as the ball across (step 3 or 4 against 1..3 a move), so
+    # that every ball can be reached: a miss is the player's, never the parameters'
+    action_keys=(4, 6), ranges={"speed_x": (1, 3), "speed_y": (1, 2), "step": (3, 4), "lives": (1, 5)},
+    sprites={"paddle": ((6, 8), (1, 2)), "ball": ((1, 3), (1, 3))},
     split="speed_x", held_out=(3,), derive=_paddle_fields, template=_PADDLE)
 
 FAMILIES: dict[str, Family] = {family.name: family for family in (DODGER, CATCHER, PADDLE)}

@@ -2,7 +2,7 @@
 
 import pytest
 
-from octax_core.generate.build import build_variant, game_over, lives, score, variant_spec
+from octax_core.generate.build import build_variant, register_functions, variant_spec
 from octax_core.generate.families import FAMILIES, get_family
 from octax_core.generate.render import check_params, render, sprite_width
 from octax_core.generate.sample import sample_params
@@ -58,8 +58,13 @@ def test_splits_hold_out_a_parameter_range():
 
 def test_every_variant_spec_shares_the_family_functions():
     specs = [variant_spec(f"v{i}", "0" * 40) for i in range(3)]
-    assert {s.score_fn for s in specs} == {score} and {s.terminated_fn for s in specs} == {game_over}
-    assert {s.lives_fn for s in specs} == {lives}
+    shared = register_functions()
+    assert {(s.score_fn, s.terminated_fn, s.lives_fn) for s in specs} == {shared}
+    other = variant_spec("llm", "0" * 40, registers={"score": 3, "lives": None, "end": [7, 2]})
+    assert other.score_fn is not shared[0] and other.lives_fn is None
+    assert variant_spec("llm2", "0" * 40, registers={"score": 3, "lives": None, "end": [7, 2]}).score_fn is other.score_fn
+    with pytest.raises(ValueError, match="score register must be V0..VE"):
+        variant_spec("bad", "0" * 40, registers={"score": 15})
 
 
 def test_the_template_documents_its_registers():
