@@ -200,14 +200,15 @@ def _with_virtual_draws(wins, games) -> tuple[np.ndarray, np.ndarray]:
 
 
 def play_ladder(env: MultiEnv, env_params, agent: Player, agent_params, key: jax.Array, *, num_games: int,
-                max_steps: int, opponents: Optional[Sequence[str]] = None,
+                max_steps: int, opponents: Optional[Sequence[str]] = None, rate: bool = True,
                 match: Optional[Callable[..., MatchResult]] = None) -> dict[str, Any]:
     """`agent` (with `agent_params`) against each opponent (default: the game's rungs), and the
     rungs' round robin that rates them: returns {"rungs": one `record` per opponent, with its
     "opponent" name, "elo": the agent's Elo against the rungs, "ladder": the rungs' Elo}.
 
     The rungs' ratings come from their round robin (`num_games` a pair) in this run, anchored at
-    "random"; the agent's Elo is fitted against them held fixed (`elo_against`). `match`: a
+    "random"; the agent's Elo is fitted against them held fixed (`elo_against`) from its games
+    against the rungs. `rate=False` skips the round robin ("elo" None, "ladder" empty). `match`: a
     match compiled by `make_match` for these players (`[agent, *ladder_players(spec)]`, then
     the other opponents), reused across calls. Every seat is passed `agent_params` (the table's
     players ignore them), so the match compiles once for one params structure.
@@ -228,6 +229,8 @@ def play_ladder(env: MultiEnv, env_params, agent: Player, agent_params, key: jax
     for k, name in enumerate(opponents):
         result = match(0, agent_params, index[name], agent_params, jax.random.fold_in(key, k))
         rows.append({"opponent": name, **record(result)})
+    if not rate:
+        return {"rungs": rows, "elo": None, "ladder": {}}
     count = len(ladder)
     points, games = np.zeros((count, count)), np.zeros((count, count))
     for i in range(count):

@@ -1,0 +1,93 @@
+"""`octax-gym evaluate` (octax_gym/cli/evaluate.py): a player name against the ladder of a real game,
+and a small saved network (the trainer's ActorCritic, saved as the loop saves agents) on
+tests/two_player_games.py's TwoCounters, where the key a network holds decides every game
+(its first key scores 4 a step, its second 8, as the scripted player does; 24 wins)."""
+
+from __future__ import annotations
+
+import json
+
+import jax
+import jax.numpy as jnp
+import pytest
+
+from octax_core.env.ladder import RUNGS
+from octax_gym import cli
+from octax_gym.cli.evaluate import evaluate
+
+from two_player_games import TWO_COUNTERS
+
+pytest.importorskip("flax")
+
+
+def test_a_player_against_the_ladder_as_json(capsys):
+    assert cli.main(["evaluate", "Cycles", "--agent", "eps0.1", "--episodes", "4", "--max-steps", "40", "--json"]) == 0
+    result = json.loads(capsys.readouterr().out)
+    assert result["game"] == "Cycles" and result["agent"] == "eps0.1" and result["policy"] == "greedy"
+    assert [row["opponent"] for row in result["rungs"]] == list(RUNGS)
+    for row in result["rungs"]:
+        assert {"opponent", "win", "draw", "loss", "margin", "episodes"} <= set(row) and row["episodes"] == 4
+        assert row["win"] + row["draw"] + row["loss"] == pytest.approx(1.0)
+    assert isinstance(result["elo"], float) and result["ladder"]["random"] == 0 and set(result["ladder"]) == set(RUNGS)
+
+
+@pytest.mark.parametrize("argv, message", [
+    (["Cycles", "--agent", "champion"], "--agent 'champion' is no file and no player"),
+    (["Cycles", "--agent", "random", "--episodes", "3"], "--episodes must be even"),
+    (["Cycles", "--agent", "random", "--opponents", "random,greedy"], "unknown player 'greedy'"),
+    (["Pong", "--agent", "random"], "Pong is a one-player game; two-player games: Cycles"),
+    (["Dual", "--agent", "random"], "unknown two-player game 'Dual' (did you mean 'Duel'?)"),
+])
+def test_bad_arguments_are_named(argv, message, capsys):
+    assert cli.main(["evaluate", *argv]) == 1
+    assert message in capsys.readouterr().err
+
+
+@pytest.fixture(scope="module")
+def network_file(tmp_path_factory, two_counters_rom):
+    """Saves an ActorCritic whose logits are its bias: `prefer` (or none: flat) at 5, output 9 (no
+    action of the game) at 9, the rest 0; `planes` other than the game's 5 cut its first kernel."""
+    from octax_core import make_multi
+    from octax_gym.train.checkpoints import save_agents
+    from octax_gym.train.networks import ActorCritic
+
+    env, _ = make_multi(TWO_COUNTERS, rom=two_counters_rom)
+    params = ActorCritic().init(jax.random.key(0), jnp.zeros((1, *env.observation_shape), jnp.uint8))["params"]
+    folder = tmp_path_factory.mktemp("agents")
+
+    def save(name: str, prefer=None, planes: int = 5):
+        logits = params["Dense_1"]
+        bias = jnp.zeros_like(logits["bias"]).at[9].set(9.0)
+        bias = bias if prefer is None else bias.at[prefer].set(5.0)
+        conv = params["ConvTorso_0"]["Conv_0"]
+        torso = {**params["ConvTorso_0"], "Conv_0": {**conv, "kernel": conv["kernel"][:, :, :planes]}}
+        tree = {"params": {**params, "ConvTorso_0": torso,
+                           "Dense_1": {"kernel": jnp.zeros_like(logits["kernel"]), "bias": bias}}}
+        return save_agents(folder / name, ["TwoCounters-seed0"], jax.tree.map(lambda x: x[None], tree))[0]
+    return save
+
+
+def _evaluate(path, rom, **options):
+    return evaluate(TWO_COUNTERS, str(path), opponents="scripted,noop", episodes=4, max_steps=10, rom=rom, **options)
+
+
+def test_a_saved_network_plays_greedily_its_legal_actions(network_file, two_counters_rom):
+    # the scripted player's key (8 a step): a tie with it, a win over noop; output 9, larger, is
+    # no action of the game and stays closed
+    second = _evaluate(network_file("second", 2), two_counters_rom)
+    assert [(r["opponent"], r["win"], r["draw"], r["loss"], r["margin"]) for r in second["rungs"]] == [
+        ("scripted", 0.0, 1.0, 0.0, 0.0), ("noop", 1.0, 0.0, 0.0, 24.0)]
+    assert second["elo"] is None and second["policy"] == "greedy" and second["agent"].endswith(".msgpack")
+
+
+def test_sampled_draws_from_the_legal_softmax(network_file, two_counters_rom):
+    # flat logits: greedy holds no-op (the first of the tied) and ties noop; sampled holds keys and wins
+    flat = network_file("flat")
+    assert _evaluate(flat, two_counters_rom)["rungs"][1]["draw"] == 1.0
+    sampled = _evaluate(flat, two_counters_rom, sampled=True, seed=3)
+    assert sampled["policy"] == "sampled" and sampled["rungs"][1]["win"] == 1.0
+
+
+def test_a_network_of_other_planes_is_refused(network_file, two_counters_rom):
+    with pytest.raises(ValueError, match="reads 2 planes; TwoCounters's seats see 5"):
+        _evaluate(network_file("two-planes", planes=2), two_counters_rom)
