@@ -5,4 +5,6 @@ ones. See docs/generate.md.
     sample     parameters drawn from a seed;  render  a variant's Octo source
     build      the source assembled, and the GameSpec every variant of every family shares
     filters    the checks every candidate of a round passes, run as one batch (a mix)
+    rounds     candidates (a family's variants) judged into archive rows
+    archive    archive.json: written byte for byte the same for the same inputs, and read back
 """

@@ -18,6 +18,8 @@ imported inside the commands. This module only wires them up and reports errors.
     octax-gym dataset collect GAME --dataset-id ID --steps N [--envs K]   a Minari dataset (docs/datasets.md)
     octax-gym play GAME|ROM [--agent PATH] [--record ID] [--port N]   play in the browser (docs/play.md)
     octax-gym train ppo|pqn [--games G,G] [--num-seeds S] [--preset paper]   agents in pure JAX (docs/training.md)
+    octax-gym generate --family F --count N --seed S --out DIR   games from a procedural family, checked, archived
+    octax-gym generate --list-families   the families (docs/generate.md)
     octax-gym evaluate GAME --agent A [--opponents ladder|NAME] [--episodes N] [--sampled] [--json]
                                          a two-player agent against the ladder: win rates, Elo (docs/multiplayer.md)
 
@@ -34,7 +36,7 @@ import sys
 import zipfile
 from typing import Optional, Sequence
 
-from octax_gym.cli import bench, dataset, evaluate, games, octo, play, record, roms, trace, train
+from octax_gym.cli import bench, dataset, evaluate, games, generate, octo, play, record, roms, trace, train
 
 
 def main(argv: Optional[Sequence[str]] = None) -> int:
@@ -104,7 +106,7 @@ def build_parser() -> argparse.ArgumentParser:
         prog="octax-gym", description="CHIP-8, SUPER-CHIP and XO-CHIP games as reinforcement-learning environments.")
     parser.add_argument("--version", action=_Version, help="print the installed version and exit")
     commands = parser.add_subparsers(title="commands", metavar="COMMAND")
-    for module in (games, roms, record, bench, octo, trace, dataset, play, train, evaluate):
+    for module in (games, roms, record, bench, octo, trace, dataset, play, train, evaluate, generate):
         module.add_commands(commands)
     return parser
 
