@@ -20,9 +20,10 @@ NAMESPACE = "octax"
 
 
 def env_id(game: Union[str, GameSpec]) -> str:
-    """The Gymnasium id of a registered game id or of a `GameSpec`, e.g. "Pong" -> "octax/Pong-v0"."""
+    """The Gymnasium id of a registered game id or of a `GameSpec`, e.g. "Pong" -> "octax/Pong-v0",
+    "Duel-v1" -> "octax/Duel-v1" (`GameSpec.base_id`)."""
     spec = game if isinstance(game, GameSpec) else get_spec(game)
-    return f"{NAMESPACE}/{spec.id}-v{spec.version}"
+    return f"{NAMESPACE}/{spec.base_id}-v{spec.version}"
 
 
 def resolve_spec(game: Union[str, GameSpec], players: int = 1) -> GameSpec:

@@ -88,7 +88,7 @@ def resolve(opponent: Any, seat: Any, spec: GameSpec) -> tuple[Optional[View], O
             raise OpponentRequiredError(
                 f"{spec.id} is played by two (its other seat must move for the game to go on): pass "
                 f"opponent= ({', '.join(map(repr, OPPONENTS))} or a function obs -> action), e.g. "
-                f"gymnasium.make('octax/{spec.id}-v{spec.version}', opponent='random'); or play both seats with "
+                f"gymnasium.make('octax/{spec.base_id}-v{spec.version}', opponent='random'); or play both seats with "
                 f"octax_gym.MultiAgentVectorEnv or octax_gym.pettingzoo")
         if not (isinstance(seat, int) and not isinstance(seat, bool) and seat == 0):
             raise ValueError(f"seat={seat!r} picks the learner's side against an opponent: pass opponent= too")

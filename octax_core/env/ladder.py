@@ -54,7 +54,7 @@ class MatchResult(NamedTuple):
 
     return_a: np.ndarray  # float32: A's return
     return_b: np.ndarray  # float32: B's return
-    ended: np.ndarray  # bool: the game ended before max_steps
+    ended: np.ndarray  # bool: the game reached its own end (terminated), not a step cap
 
 
 def make_match(env: MultiEnv, env_params, num_games: int, max_steps: int,
@@ -92,11 +92,11 @@ def make_match(env: MultiEnv, env_params, num_games: int, max_steps: int,
         obs, state = v_reset(jax.random.split(reset_key, num_games), env_params)
 
         def running(carry):
-            t, _, _, _, _, ended = carry
-            return (t < max_steps) & ~ended.all()
+            t, _, _, _, _, done, _ = carry
+            return (t < max_steps) & ~done.all()
 
         def body(carry):
-            t, key, obs, state, returns, ended = carry
+            t, key, obs, state, returns, done, ended = carry
             key, a_key, b_key, step_key = jax.random.split(key, 4)
             legal = legal_of(state)
             act_a = jax.lax.switch(index_a, batched, params_a, jax.random.split(a_key, num_games), obs[rows, a_seat],
@@ -107,11 +107,11 @@ def make_match(env: MultiEnv, env_params, num_games: int, max_steps: int,
             obs, state, reward, terminated, truncated, _ = v_step(
                 jax.random.split(step_key, num_games), state, actions, env_params)
             # An ended game stands still and pays 0 (no autoreset), so summing every step is safe.
-            return t + 1, key, obs, state, returns + reward, ended | terminated | truncated
+            return t + 1, key, obs, state, returns + reward, done | terminated | truncated, ended | terminated
 
-        carry = (jnp.int32(0), key, obs, state, jnp.zeros((num_games, 2), jnp.float32),
-                 jnp.zeros(num_games, jnp.bool_))
-        _, _, _, _, returns, ended = jax.lax.while_loop(running, body, carry)
+        no = jnp.zeros(num_games, jnp.bool_)
+        carry = (jnp.int32(0), key, obs, state, jnp.zeros((num_games, 2), jnp.float32), no, no)
+        _, _, _, _, returns, _, ended = jax.lax.while_loop(running, body, carry)
         return MatchResult(returns[rows, a_seat], returns[rows, b_seat], ended)
 
     compiled = jax.jit(match, compiler_options=env.compiler_options)  # the platform's (exact; faster)
@@ -132,7 +132,8 @@ def _batched(player: Player) -> Callable:
 
 def record(result: MatchResult) -> dict[str, Any]:
     """A's record in a match: win, draw and loss rates, the mean margin (A's return - B's), the
-    fraction of games that ended before the step cap, and the number of episodes."""
+    fraction of games that reached their own end (not a step cap: the match's or the env's
+    truncation), and the number of episodes."""
     a, b = np.asarray(result.return_a, np.float64), np.asarray(result.return_b, np.float64)
     return {"win": float((a > b).mean()), "draw": float((a == b).mean()), "loss": float((a < b).mean()),
             "margin": float((a - b).mean()), "ended": float(np.asarray(result.ended).mean()), "episodes": int(a.size)}

@@ -44,6 +44,9 @@ first serve (40 frames) and the 20 frames a serve waits at the centre, the paddl
 each episode's reset key. Episodes are cut at 4,500 steps (5 minutes).
 """
 
+import dataclasses
+import functools
+
 import jax
 import jax.numpy as jnp
 
@@ -53,6 +56,7 @@ PAD1, PAD2, SCORE1, SCORE2, BALL_X, BALL_Y, BALL_DX, BALL_DY, GAME_OVER = 3, 4, 
 WIN = 7
 PADDLE_X = (2, 61)
 HIT_X = (3, 59)  # the ball's x beside each paddle
+BALL_SPEED = {0: 2, 1: 6}  # pixels a move across, by version (roms/duel.8o, roms/duel_v1.8o)
 
 
 def _scores(state):
@@ -61,24 +65,26 @@ def _scores(state):
     return points - points[::-1]
 
 
-def _crossing_row(state, seat: int):
+def _crossing_row(state, seat: int, speed: int = 2):
     """The row the ball's top will have when it reaches `seat`'s paddle column (folding its bounces
-    off rows 0 and 30), or where it is now if it moves away from that side."""
+    off rows 0 and 30), or where it is now if it moves away from that side. `speed`: the ball's
+    pixels a move across; the move that would pass the paddle's face stops there (v1), so the
+    moves left are the distance over `speed`, rounded up (exact in v0, whose x is always odd)."""
     x = register_value(state, BALL_X)
     y = register_value(state, BALL_Y)
-    dx = jnp.where(state.V[BALL_DX] == 2, 2, -2)
+    dx = jnp.where(state.V[BALL_DX] == speed, speed, -speed)
     dy = jnp.where(state.V[BALL_DY] >= 128, register_value(state, BALL_DY) - 256, register_value(state, BALL_DY))
-    toward = dx == (-2 if seat == 0 else 2)
-    moves = jnp.abs(HIT_X[seat] - x) // 2
+    toward = dx == (-speed if seat == 0 else speed)
+    moves = (jnp.abs(HIT_X[seat] - x) + speed - 1) // speed
     unfolded = jnp.mod(y + dy * moves, 60)  # the bounces fold y into 0..30: a period of 60
     folded = jnp.where(unfolded > 30, 60 - unfolded, unfolded)
     return jnp.where(toward, folded, 14)
 
 
-def scripted_policy(state, seat: int) -> jax.Array:
+def scripted_policy(state, seat: int, speed: int = 2) -> jax.Array:
     """Move the paddle's middle (rows p+2, p+3) to where the ball will cross its column."""
     paddle = register_value(state, PAD1 if seat == 0 else PAD2)
-    target = _crossing_row(state, seat) + 1 - 3  # the ball's rows y, y+1 on the paddle's middle
+    target = _crossing_row(state, seat, speed) + 1 - 3  # the ball's rows y, y+1 on the paddle's middle
     return jnp.where(target < paddle, 1, jnp.where(target > paddle, 2, 0)).astype(jnp.int32)
 
 
@@ -91,7 +97,7 @@ SEATS = Seats(
 )
 
 SUITE = "ours"
-SPECS = (GameSpec(
+DUEL = GameSpec(
     id="Duel",
     title="Duel (two-player volley, first to 7)",
     rom_file="duel.ch8",
@@ -110,4 +116,25 @@ SPECS = (GameSpec(
                 "point for the other side; first to 7 points ends the game (VE == 1). Two players: "
                 "zero-sum rewards, +1/-1 per point; one player (against an idle right paddle): +1 "
                 "per point.",
-),)
+)
+# Version 1 (roms/duel_v1.8o, where the changes and their reasons are written): the ball moves 6
+# pixels a move across instead of 2 and is drawn in every frame, so a paddle cannot always get
+# there in time and the scripted player, the same reader of the ball, concedes points to itself.
+# A two-player game only (not solo): it exists for the ladder (docs/multiplayer.md); the
+# one-player view is a seat against an opponent (`opponent=`).
+DUEL_V1 = dataclasses.replace(
+    DUEL,
+    id="Duel-v1",
+    version=1,
+    title="Duel v1 (two-player volley, a fast ball, first to 7)",
+    rom_file="duel_v1.ch8",
+    rom_sha1="542fb42490a028bb58aadb1631ed1042467dfc6d",
+    solo=False,
+    seats=dataclasses.replace(SEATS, scripted_policy=functools.partial(scripted_policy, speed=BALL_SPEED[1])),
+    description="Duel with a ball three times as fast (6 pixels a move across) and drawn in every frame: a "
+                "paddle cannot always reach the ball in time, so even the scripted players concede points. Keys, "
+                "bounces, serve, scores and the end as Duel's (player 1 left: keys 1 up, 4 down; player 2 right: "
+                "C up, D down; first to 7 points ends the game, VE == 1); zero-sum rewards, +1/-1 per point. Two "
+                "players only: the one-agent view is a seat against an opponent.",
+)
+SPECS = (DUEL, DUEL_V1)

@@ -7,6 +7,7 @@ API (`octax_core.env.environment`) that runs it. Each game module in this packag
 from __future__ import annotations
 
 import dataclasses
+import re
 from typing import Callable, Optional, Union
 
 import jax
@@ -107,7 +108,10 @@ class GameSpec:
         max_episode_steps: default truncation (env steps of `frames_per_step` frames).
         category: the paper's category (see `CATEGORIES`).
         description: one paragraph: goal, keys, reward, termination.
-        version: bumped when behaviour changes (the Gymnasium id's -vN).
+        version: bumped when behaviour changes (the Gymnasium id's -vN). A changed game that
+            keeps its old version registered beside it (Duel-v0 and Duel-v1) takes the id
+            "<Name>-v<version>" ("Duel-v1"): the id stays unique in the registry, and its
+            Gymnasium id is octax/<Name>-v<version> (`base_id`).
         seats: a two-player game's `Seats` (`octax_core.make_multi` builds its multi-agent env);
             None (the default) for a one-player game.
         solo: the game is also a one-player env (`make`; player 2, where there is one, holds no
@@ -157,12 +161,23 @@ class GameSpec:
             raise ValueError(f"{self.id}: max_episode_steps must be positive, got {self.max_episode_steps}")
         if not self.solo and self.seats is None:
             raise ValueError(f"{self.id}: a game that is not solo must have seats (it is played by two)")
+        suffix = _VERSION_SUFFIX.search(self.id)
+        if suffix and int(suffix.group(1)) != self.version:
+            raise ValueError(f"{self.id}: an id ending in -v{suffix.group(1)} names that version; its version is "
+                             f"{self.version}")
+
+    @property
+    def base_id(self) -> str:
+        """The game's name without a version suffix: "Duel" for "Duel-v1" (the Gymnasium id's name)."""
+        return _VERSION_SUFFIX.sub("", self.id)
 
     @property
     def players(self) -> int:
         """The most players the game takes: 2 where it has `seats`, else 1."""
         return 1 if self.seats is None else self.seats.players
 
+
+_VERSION_SUFFIX = re.compile(r"-v(\d+)$")  # "Duel-v1": the id of a game's version 1 registered beside its v0
 
 CATEGORIES = (
     "planning",  # Long-horizon planning & spatial reasoning
