@@ -2,11 +2,14 @@
 
     octax-gym generate --list-families
     octax-gym generate --family dodger --count 64 --seed 0 --out generated/dodger
+    octax-gym generate --llm-url http://127.0.0.1:8000/v1 --model M --description TEXT --count 4 --repairs 3 --out DIR
 
 Writes each candidate's Octo source (NAME.8o) and ROM (NAME.ch8) into the folder, and
 `archive.json`: every candidate with its parameters, hash, split, scores and, for a rejected
 one, the reasons (`octax_core.generate.filters`). The same arguments write the same archive,
-byte for byte. `octax_gym.generated.load_archive(DIR)` plays it. See docs/generate.md.
+byte for byte. With --llm-url, the programs come from a language model through the paper's loop
+(`octax_core.generate.llm`: the assembler's messages sent back up to --repairs times) and go
+through the same checks. `octax_gym.generated.load_archive(DIR)` plays it. See docs/generate.md.
 """
 
 from __future__ import annotations
@@ -28,6 +31,21 @@ def add_commands(commands: argparse._SubParsersAction) -> None:
     generate.add_argument("--count", type=int, default=16, metavar="N", help="candidates (default 16)")
     generate.add_argument("--seed", type=int, default=0, metavar="S", help="the sampling seed (default 0)")
     generate.add_argument("--out", type=Path, metavar="DIR", help="the folder to write (created)")
+    llm = generate.add_argument_group("the LLM path (the paper's loop; in place of --family)")
+    llm.add_argument("--llm-url", metavar="URL", help="an OpenAI-compatible API, e.g. http://127.0.0.1:8000/v1")
+    llm.add_argument("--model", metavar="M", help="the model the server is asked for")
+    llm.add_argument("--description", action="append", default=[], metavar="TEXT",
+                     help="a game to write (repeatable; --count games cycle through the descriptions)")
+    llm.add_argument("--descriptions", type=Path, metavar="FILE", help="descriptions, one a line")
+    llm.add_argument("--repairs", type=int, default=3, metavar="K",
+                     help="times a program that does not assemble goes back with the assembler's message (default 3)")
+    llm.add_argument("--api-key-env", default="OPENAI_API_KEY", metavar="VAR",
+                     help="the environment variable holding the API key (default OPENAI_API_KEY; unset: no key sent)")
+    llm.add_argument("--prompt-part", action="append", default=[], metavar="NAME=PATH",
+                     help="fill a part of the paper's prompt from a file: documentation, tutorial1, tutorial2 or example")
+    llm.add_argument("--temperature", type=float, metavar="T", help="sampling temperature (default: the server's)")
+    llm.add_argument("--trace-steps", type=int, default=1500, metavar="N",
+                     help="steps the register tracer plays to check (or find) the score and end (default 1500)")
     checks = generate.add_argument_group("checks (left out: the archive's own, octax_core.generate.filters.Settings; "
                                          "smaller is quicker and looser)")
     for name, help_text in (("frames", "random-play frames each candidate must run without a fault (10000)"),
@@ -50,6 +68,8 @@ def _cmd_generate(args: argparse.Namespace) -> int:
                   + ", sprites: " + ", ".join(family.sprites)
                   + f"; test split: {family.split} in {list(family.held_out)} (of {low}..{high})")
         return 0
+    if args.llm_url is not None:
+        return _cmd_llm(args)
     if args.out is None or args.family is None:
         raise ValueError("generate needs --family F and --out DIR (or --list-families); families: "
                          + ", ".join(FAMILIES))
@@ -64,6 +84,51 @@ def _cmd_generate(args: argparse.Namespace) -> int:
 
     candidates = rounds.family_candidates(FAMILIES[args.family], args.count, args.seed)
     write_round(args.out, candidates, _settings(args), {"family": args.family, "count": args.count, "seed": args.seed})
+    return 0
+
+
+def _cmd_llm(args: argparse.Namespace) -> int:
+    import os
+
+    if args.family is not None:
+        raise ValueError("give --family (a procedural family) or --llm-url (the LLM path), not both")
+    descriptions = list(args.description)
+    if args.descriptions is not None:
+        try:
+            text = args.descriptions.read_text(encoding="utf-8")
+        except OSError as exc:
+            raise ValueError(f"--descriptions: cannot read {args.descriptions}: {exc.strerror}") from None
+        descriptions += [line.strip() for line in text.splitlines() if line.strip()]
+    if args.model is None or args.out is None or not descriptions:
+        raise ValueError("the LLM path needs --llm-url URL, --model M, --out DIR and --description TEXT "
+                         "(or --descriptions FILE)")
+    for name, low in (("count", 1), ("repairs", 0), ("trace_steps", 1)):
+        if getattr(args, name) < low:
+            raise ValueError(f"--{name.replace('_', '-')} must be >= {low}, got {getattr(args, name)}")
+    paths = {}
+    for item in args.prompt_part:
+        name, sep, path = item.partition("=")
+        if not sep or not path:
+            raise ValueError(f"--prompt-part takes NAME=PATH, got {item!r}")
+        paths[name] = path
+    from octax_core.generate import chat, llm, prompt
+
+    parts = prompt.read_parts(paths)
+    chat.endpoint(args.llm_url)  # a bad URL is refused before any work
+    key = os.environ.get(args.api_key_env) or None
+
+    def ask(messages):
+        return chat.complete(args.llm_url, args.model, messages, api_key=key, temperature=args.temperature)
+    candidates = []
+    for index in range(args.count):
+        description = descriptions[index % len(descriptions)]
+        candidate = llm.llm_candidate(ask, description, f"llm-{index:04d}", args.repairs, parts, model=args.model,
+                                      trace_steps=args.trace_steps)
+        print(f"{candidate.name}: {'assembled' if candidate.rom is not None else 'did not assemble'} after "
+              f"{candidate.params['replies']} repl{'y' if candidate.params['replies'] == 1 else 'ies'}", flush=True)
+        candidates.append(candidate)
+    write_round(args.out, candidates, _settings(args),
+                {"llm_url": args.llm_url, "model": args.model, "count": args.count, "repairs": args.repairs})
     return 0
 
 
