@@ -133,10 +133,18 @@ def _batched(player: Player) -> Callable:
 def record(result: MatchResult) -> dict[str, Any]:
     """A's record in a match: win, draw and loss rates, the mean margin (A's return - B's), the
     fraction of games that reached their own end (not a step cap: the match's or the env's
-    truncation), and the number of episodes."""
+    truncation), the number of episodes, and "by_seat": win, draw, loss and margin of A's games
+    from seat 0 (the first half) and from seat 1, for the games whose seats are not alike
+    (Paddles' bottom paddle concedes nothing to the scripted top one)."""
     a, b = np.asarray(result.return_a, np.float64), np.asarray(result.return_b, np.float64)
+    half = a.size // 2
+    return {**_rates(a, b), "ended": float(np.asarray(result.ended).mean()), "episodes": int(a.size),
+            "by_seat": [_rates(a[:half], b[:half]), _rates(a[half:], b[half:])]}
+
+
+def _rates(a: np.ndarray, b: np.ndarray) -> dict[str, float]:
     return {"win": float((a > b).mean()), "draw": float((a == b).mean()), "loss": float((a < b).mean()),
-            "margin": float((a - b).mean()), "ended": float(np.asarray(result.ended).mean()), "episodes": int(a.size)}
+            "margin": float((a - b).mean())}
 
 
 def bradley_terry_elo(wins, games, anchor: int, iterations: int = BT_ITERATIONS) -> np.ndarray:

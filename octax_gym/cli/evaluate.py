@@ -17,8 +17,10 @@ self-play policy at 1.06 nats of entropy on Cycles, about a quarter of its moves
 10% random moves even the scripted Cycles player wins none of 32 games against itself.
 
 `--json` prints one object: {"game", "agent", "policy", "episodes", "max_steps", "rungs": [{"opponent",
-"win", "draw", "loss", "margin", "ended", "episodes"}, ...], "elo", "ladder": {rung: Elo}}; win, draw
-and loss are fractions of the episodes, margin the mean of the agent's return minus the opponent's.
+"win", "draw", "loss", "margin", "ended", "episodes", "by_seat"}, ...], "elo", "ladder": {rung: Elo}}; win,
+draw and loss are fractions of the episodes, margin the mean of the agent's return minus the
+opponent's, by_seat the same four from each seat (a game whose seats differ, Paddles, shows which
+seat can be beaten).
 """
 
 from __future__ import annotations
@@ -154,9 +156,10 @@ def format_result(result: dict) -> str:
     """The table `octax-gym evaluate` prints without --json."""
     lines = [f"{result['game']}: {result['agent']} ({result['policy']}), {result['episodes']} episodes per "
              f"opponent (half from each seat), at most {result['max_steps']} steps each"]
-    header = ("opponent", "win", "draw", "loss", "margin", "ended")
+    header = ("opponent", "win", "draw", "loss", "margin", "from seat 0 / 1", "ended")
     rows = [header] + [(row["opponent"], f"{row['win']:.2f}", f"{row['draw']:.2f}", f"{row['loss']:.2f}",
-                        f"{row['margin']:+.2f}", f"{row['ended']:.2f}") for row in result["rungs"]]
+                        f"{row['margin']:+.2f}", " / ".join(f"{seat['margin']:+.2f}" for seat in row["by_seat"]),
+                        f"{row['ended']:.2f}") for row in result["rungs"]]
     widths = [max(len(r[i]) for r in rows) for i in range(len(header))]
     lines += ["  ".join(cell.ljust(w) for cell, w in zip(r, widths)).rstrip() for r in rows]
     if result["elo"] is not None:

@@ -51,7 +51,9 @@ def test_a_plays_seat_0_in_the_first_half_and_seat_1_in_the_second(counters):
     swapped = match(NETWORK, NOTHING, SEAT_0, NOTHING, jax.random.key(0))  # B on seat 0 in the second half
     np.testing.assert_array_equal(swapped.return_b, [0] * half + [GOAL] * half)
     assert record(result) == {"win": 0.5, "draw": 0.5, "loss": 0.0, "margin": GOAL / 2, "ended": 0.5,
-                              "episodes": GAMES}
+                              "episodes": GAMES,
+                              "by_seat": [{"win": 1.0, "draw": 0.0, "loss": 0.0, "margin": GOAL},
+                                          {"win": 0.0, "draw": 1.0, "loss": 0.0, "margin": 0.0}]}
 
 
 def test_params_are_an_argument_not_a_constant(counters):
@@ -103,7 +105,7 @@ def test_the_ladder_of_a_game_and_the_agents_elo(counters):
     table = play_ladder(env, params, params_scale, SECOND, jax.random.key(1), num_games=GAMES, max_steps=20,
                         match=match)
     assert [row["opponent"] for row in table["rungs"]] == list(RUNGS)
-    assert set(table["rungs"][0]) == {"opponent", "win", "draw", "loss", "margin", "ended", "episodes"}
+    assert set(table["rungs"][0]) == {"opponent", "win", "draw", "loss", "margin", "ended", "episodes", "by_seat"}
     ladder = table["ladder"]
     assert ladder["random"] == 0 and ladder["scripted"] > ladder["eps0.5"] > ladder["random"]
     assert table["rungs"][0]["win"] > 0.9 and table["rungs"][-1]["draw"] == 1.0  # scripted vs itself: a tie

@@ -13,7 +13,7 @@ import pytest
 
 from octax_core.env.ladder import RUNGS
 from octax_gym import cli
-from octax_gym.cli.evaluate import evaluate
+from octax_gym.cli.evaluate import evaluate, format_result
 
 from two_player_games import TWO_COUNTERS
 
@@ -29,6 +29,10 @@ def test_a_player_against_the_ladder_as_json(capsys):
         assert {"opponent", "win", "draw", "loss", "margin", "episodes"} <= set(row) and row["episodes"] == 4
         assert row["win"] + row["draw"] + row["loss"] == pytest.approx(1.0)
     assert isinstance(result["elo"], float) and result["ladder"]["random"] == 0 and set(result["ladder"]) == set(RUNGS)
+    assert all(len(row["by_seat"]) == 2 for row in result["rungs"])
+    table = format_result(result).splitlines()  # what the command prints without --json
+    assert table[1].split() == ["opponent", "win", "draw", "loss", "margin", "from", "seat", "0", "/", "1", "ended"]
+    assert [line.split()[0] for line in table[2:-1]] == list(RUNGS) and table[-1].startswith("Elo ")
 
 
 @pytest.mark.parametrize("argv, message", [
