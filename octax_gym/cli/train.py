@@ -5,6 +5,7 @@
     octax-gym train ppo --preset paper --games octax16 --num-seeds 3              # the paper's table, on a GPU
     octax-gym train ppo --resume runs/ppo                                           # a run cut short, continued
     octax-gym train multitask --games Airplane,Brix,Deep8,Filter --num-envs 64       # one agent for all four
+    octax-gym train selfplay --game Cycles --pool 4                                  # both seats, past selves
     octax-gym train bc --dataset octax/Flak/expert-v0 --num-seeds 2                  # offline, on a dataset
 
 Settings start from a preset (`--preset cpu`, the default, or `paper`) and each flag given
@@ -19,18 +20,20 @@ import json
 from pathlib import Path
 
 TRAIN_HINT = "pip install 'octax-gym[train]'"
-ALGORITHMS = ("ppo", "pqn", "multitask", "bc", "cql")
+ALGORITHMS = ("ppo", "pqn", "multitask", "selfplay", "bc", "cql")
 PPO_ONLY = ("gae_lambda", "clip_eps", "clip_value_loss", "vf_coef", "ent_coef")
 EXPLORATION = ("q_lambda", "epsilon_start", "epsilon_finish", "epsilon_fraction")
 PQN_ONLY = EXPLORATION + ("eval_epsilon",)  # eval_epsilon: CQL's too
 MULTITASK_ONLY = ("game_input",)
 OFFLINE_ONLY = ("dataset",)
 CQL_ONLY = ("cql_alpha", "target_every")
-NOT_OF = {"ppo": PQN_ONLY + MULTITASK_ONLY + OFFLINE_ONLY + CQL_ONLY,
-          "pqn": PPO_ONLY + MULTITASK_ONLY + OFFLINE_ONLY + CQL_ONLY,
-          "multitask": PQN_ONLY + OFFLINE_ONLY + CQL_ONLY,
-          "bc": PPO_ONLY + PQN_ONLY + MULTITASK_ONLY + CQL_ONLY,
-          "cql": PPO_ONLY + EXPLORATION + MULTITASK_ONLY}
+SELFPLAY_ONLY = ("pool", "pool_prob")
+NOT_OF = {"ppo": PQN_ONLY + MULTITASK_ONLY + OFFLINE_ONLY + CQL_ONLY + SELFPLAY_ONLY,
+          "pqn": PPO_ONLY + MULTITASK_ONLY + OFFLINE_ONLY + CQL_ONLY + SELFPLAY_ONLY,
+          "multitask": PQN_ONLY + OFFLINE_ONLY + CQL_ONLY + SELFPLAY_ONLY,
+          "selfplay": PQN_ONLY + MULTITASK_ONLY + OFFLINE_ONLY + CQL_ONLY,
+          "bc": PPO_ONLY + PQN_ONLY + MULTITASK_ONLY + CQL_ONLY + SELFPLAY_ONLY,
+          "cql": PPO_ONLY + EXPLORATION + MULTITASK_ONLY + SELFPLAY_ONLY}
 ENV_FLAGS = {"max_episode_steps": int, "frames_per_step": int, "repeat_action_probability": float, "noop_max": int}
 SETTINGS = {  # flag -> (type, help); each a TrainConfig field
     "seed": (int, "the first seed: seeds S..S+N-1 each train one agent per game"),
@@ -60,20 +63,24 @@ SETTINGS = {  # flag -> (type, help); each a TrainConfig field
     "dataset": (str, "bc, cql: the Minari dataset id to train on (its game and env options are the run's)"),
     "cql_alpha": (float, "CQL: weight of the conservative regulariser"),
     "target_every": (int, "CQL: updates between copies of the target network"),
+    "pool": (int, "selfplay: K past selves (a snapshot per evaluation) as opponents; 0: pure self-play"),
+    "pool_prob": (float, "selfplay: per env and update, the chance that one seat is played by a past self"),
 }
 
 
 def add_commands(commands: argparse._SubParsersAction) -> None:
     train = commands.add_parser(
-        "train", help="train PPO or PQN agents in pure JAX: many games x seeds in one program (or multi-task)",
+        "train", help="train PPO or PQN agents in pure JAX: many games x seeds in one program (or multi-task, "
+                      "self-play)",
         description="Trains one agent per game and seed (not one agent for all games) in one jitted program, "
-                    "(multitask: one PPO agent per seed for all the games, lane i playing game i mod G; bc, cql: "
-                    "offline, from the Minari dataset --dataset), "
+                    "(multitask: one PPO agent per seed for all the games, lane i playing game i mod G; selfplay: "
+                    "one PPO agent per seed on both seats of a two-player game, evaluated in matches against "
+                    "random and scripted players; bc, cql: offline, from the Minari dataset --dataset), "
                     "writing OUT/progress.csv (a row per game, seed and evaluation), OUT/learning_curve.png, "
                     "OUT/agents/<game>-seed<s>.msgpack and OUT/summary.json. Needs the train extra: "
                     + TRAIN_HINT + ". See docs/training.md.")
     train.add_argument("algorithm", choices=ALGORITHMS, metavar="ALGO",
-                       help="ppo, pqn, multitask, or bc and cql (offline, on --dataset)")
+                       help="ppo, pqn, multitask, selfplay (a two-player game), or bc and cql (offline, on --dataset)")
     train.add_argument("--games", "--game", dest="games", metavar="G[,G...]",
                        help="game ids, comma-separated, or octax16 (the paper's 16); default Brix")
     train.add_argument("--preset", default="cpu", metavar="NAME",

@@ -11,7 +11,8 @@ mix, each agent's lanes fixed to its game), `many` (the agent axis), `rollout` (
 minibatch epochs), `ppo` and `pqn` (acting, targets, losses), `offline` (BC and CQL on a Minari
 dataset: a draw instead of a rollout), `evaluate`, `log` (progress.csv),
 `figure`, `report` (IQM and intervals), `checkpoints`, `parallel` (`--devices all`), `config`,
-`presets`, and `loop` (the one loop). Needs the `train` extra: pip install 'octax-gym[train]'.
+`presets`, `seats` and `selfplay` (both seats of a two-player game as lanes, the pool of past
+selves, evaluation in matches: `octax-gym train selfplay`), and `loop` (the one loop). Needs the `train` extra: pip install 'octax-gym[train]'.
 See docs/training.md.
 """
 

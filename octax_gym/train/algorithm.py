@@ -33,7 +33,7 @@ class Trainer(NamedTuple):
 
 def make_trainer(config: TrainConfig, lanes: Lanes) -> Trainer:
     """The `config.algorithm` trainer for `lanes`."""
-    if config.algorithm in ("ppo", "multitask"):
+    if config.algorithm in ("ppo", "multitask", "selfplay"):  # selfplay: PPO on two-seat lanes (selfplay.py)
         from octax_gym.train import ppo
         return ppo.make_trainer(config, lanes)
     if config.algorithm == "pqn":
@@ -42,4 +42,4 @@ def make_trainer(config: TrainConfig, lanes: Lanes) -> Trainer:
     if config.algorithm in ("bc", "cql"):
         from octax_gym.train import offline
         return offline.make_trainer(config, lanes)
-    raise ValueError(f"algorithm must be one of ppo, pqn, multitask, bc, cql, got {config.algorithm!r}")
+    raise ValueError(f"algorithm must be one of ppo, pqn, multitask, selfplay, bc, cql, got {config.algorithm!r}")

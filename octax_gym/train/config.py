@@ -14,7 +14,8 @@ from typing import Any, Optional, Union
 from octax_core.env.games import GameSpec
 from octax_core.env.mix import MIXES
 
-ALGORITHMS = ("ppo", "pqn", "multitask", "bc", "cql")  # multitask: one PPO agent per seed over all the games
+ALGORITHMS = ("ppo", "pqn", "multitask", "selfplay", "bc", "cql")  # multitask: one PPO agent per seed over all
+# the games; selfplay: one PPO agent per seed on both seats of a two-player game (seats.py, selfplay.py)
 OFFLINE = ("bc", "cql")  # trained on a Minari dataset instead of a rollout (offline.py)
 DEVICES = ("", "all")
 AGENT_MAPS = ("auto", "vmap", "map")
@@ -66,6 +67,9 @@ class TrainConfig:
     eval_epsilon: float = 0.005  # the sampled evaluation of PQN: epsilon-greedy (the paper's code)
     # multitask's
     game_input: bool = True  # the game's one-hot joins the torso's features (else the screen alone tells)
+    # selfplay's
+    pool: int = 0  # K past selves (one snapshot per evaluation) as opponents; 0: pure self-play
+    pool_prob: float = 0.5  # per env and update, the chance that one seat is played by a drawn past self
     # offline (bc, cql)
     dataset: str = ""  # the Minari dataset id trained on; the run's game and env options are the dataset's
     cql_alpha: float = 1.0  # weight of CQL's regulariser
@@ -80,6 +84,13 @@ class TrainConfig:
         return max(1, self.total_steps // self.batch_size)
 
     @property
+    def eval_interval(self) -> int:
+        """Updates between evaluations (and self-play's pool snapshots); the last update is evaluated too."""
+        if not self.eval_every:
+            return self.num_updates
+        return max(1, round(self.eval_every / self.batch_size))
+
+    @property
     def seeds(self) -> list[int]:
         return [self.seed + i for i in range(self.num_seeds)]
 
@@ -90,6 +101,10 @@ class TrainConfig:
     @property
     def multitask(self) -> bool:
         return self.algorithm == "multitask"
+
+    @property
+    def selfplay(self) -> bool:
+        return self.algorithm == "selfplay"
 
     @property
     def agents(self) -> list[tuple[str, int]]:
@@ -152,7 +167,7 @@ class TrainConfig:
             if not getattr(self, name) > 0:
                 raise ValueError(f"{name} must be > 0, got {getattr(self, name)}")
         for name in ("gamma", "gae_lambda", "q_lambda", "epsilon_start", "epsilon_finish", "epsilon_fraction",
-                     "eval_epsilon"):
+                     "eval_epsilon", "pool_prob"):
             if not 0 <= getattr(self, name) <= 1:
                 raise ValueError(f"{name} must be in [0, 1], got {getattr(self, name)}")
         for name, value in self.env_overrides:
@@ -171,6 +186,23 @@ class TrainConfig:
         _at_least("target_every", self.target_every, 1)
         if not self.cql_alpha >= 0:
             raise ValueError(f"cql_alpha must be >= 0, got {self.cql_alpha}")
+        _at_least("pool", self.pool, 0)
+        if self.pool and not self.selfplay:
+            raise ValueError(f"pool is a setting of selfplay, not of {self.algorithm}")
+        if self.selfplay:
+            if len(self.games) != 1:
+                raise ValueError(f"selfplay trains on one two-player game; got games {', '.join(self.game_ids)}")
+            from octax_core.env.games import get_spec, list_games
+
+            spec = self.games[0] if isinstance(self.games[0], GameSpec) else get_spec(self.games[0])
+            if spec.seats is None:
+                raise ValueError(f"selfplay: {spec.id} is a one-player game; two-player games: "
+                                 f"{', '.join(list_games(players=2))}")
+            if self.eval_envs % 2:
+                raise ValueError(f"selfplay: eval_envs = {self.eval_envs} must be even (half the evaluation games "
+                                 "from each seat)")
+            if self.devices:
+                raise ValueError("devices must be '' for selfplay (its two-seat envs run on one device)")
         if self.multitask and self.num_envs % len(self.games):
             raise ValueError(f"multitask: num_envs = {self.num_envs} must be a multiple of the {len(self.games)} "
                              "games (lane i plays game i mod G, so each game gets as many lanes)")

@@ -72,6 +72,11 @@ class Lanes:
         keys = jax.random.split(key, action.shape[0])
         return jax.vmap(self._step_one)(keys, state, action)
 
+    def legal_mask(self, state, game) -> jax.Array:
+        """(num_envs, ACTIONS) bool: each lane's legal actions, its game's static row (`legal`)
+        (seats.py's two-seat lanes read theirs from the state: the one rollout takes either)."""
+        return jnp.broadcast_to(jnp.asarray(self.legal)[game], (state.done.shape[0], ACTIONS))
+
     def eval_step(self, key: jax.Array, state, action: jax.Array):
         """One step of a batch of evaluation lanes (no autoreset: an ended episode stands still)."""
         keys = jax.random.split(key, action.shape[0])

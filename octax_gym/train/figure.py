@@ -47,7 +47,7 @@ def _panel(ax, rows: Sequence[dict], game: str) -> None:
         bands = [scores.stratified_bootstrap_ci(v, scores.mean, reps=BAND_REPS) for v in by_step]
         ax.fill_between(steps, [b.low for b in bands], [b.high for b in bands], color="C0", alpha=0.25,
                         label="95% CI")
-    random_mean = rows[0]["random_mean_return"] if rows else math.nan
+    random_mean = rows[0].get("random_mean_return", math.nan) if rows else math.nan  # self-play rows have none
     if not math.isnan(random_mean):
         ax.axhline(random_mean, color="gray", linestyle=":", label="random")
     ax.set_title(game, fontsize="small")

@@ -7,6 +7,10 @@ Columns: the agent (`game`, `seed`), where the run is (`step` per agent, `update
 the normalized score from the committed table (`octax_gym.scores`: never re-measured here), the
 training episodes finished since the last evaluation, and the algorithm's metrics averaged over
 those updates. A resumed run rewrites the file with the rows up to its checkpoint.
+
+A self-play run's evaluation columns are its matches' (selfplay.py's `EVAL_COLUMNS`: win, draw,
+loss and margin against each opponent, greedy and sampled) in place of the one-player ones
+(`EVAL_COLUMNS` here); the other columns are the same.
 """
 
 from __future__ import annotations
@@ -14,16 +18,17 @@ from __future__ import annotations
 import csv
 import math
 from pathlib import Path
-from typing import Optional, Sequence
+from typing import Callable, Optional, Sequence
 
 import numpy as np
 
 from octax_gym import scores
 
-COMMON_COLUMNS = ("game", "seed", "step", "update", "wall_s", "env_steps_per_s", "eval_mean_return", "eval_std",
-                  "eval_greedy_return", "eval_greedy_std", "eval_sampled_return", "eval_sampled_std",
-                  "eval_ended_frac", "random_mean_return", "normalized_score", "train_episode_return",
-                  "train_episodes")
+HEAD_COLUMNS = ("game", "seed", "step", "update", "wall_s", "env_steps_per_s")
+EVAL_COLUMNS = ("eval_mean_return", "eval_std", "eval_greedy_return", "eval_greedy_std", "eval_sampled_return",
+                "eval_sampled_std", "eval_ended_frac", "random_mean_return", "normalized_score")
+TRAIN_COLUMNS = ("train_episode_return", "train_episodes")
+COMMON_COLUMNS = HEAD_COLUMNS + EVAL_COLUMNS + TRAIN_COLUMNS
 
 
 def baseline(game: str) -> tuple[float, Optional[float]]:
@@ -41,19 +46,32 @@ def normalized(game: str, value: float) -> float:
     return float(scores.normalized_score(game, value))
 
 
+def evaluation_cells(evaluation, i: int, game: str) -> dict:
+    """Row `i`'s `EVAL_COLUMNS` from a one-player `Evaluation` of (num_rows, eval_envs) arrays."""
+    greedy, sampled = np.asarray(evaluation.greedy_return[i]), np.asarray(evaluation.sampled_return[i])
+    ended = np.concatenate([np.asarray(evaluation.greedy_ended[i]), np.asarray(evaluation.sampled_ended[i])])
+    mean = float(sampled.mean())
+    return {"eval_mean_return": mean, "eval_std": float(sampled.std()),
+            "eval_greedy_return": float(greedy.mean()), "eval_greedy_std": float(greedy.std()),
+            "eval_sampled_return": mean, "eval_sampled_std": float(sampled.std()),
+            "eval_ended_frac": float(ended.mean()), "random_mean_return": baseline(game)[0],
+            "normalized_score": normalized(game, mean)}
+
+
 class ProgressLog:
     """Appends the rows of each evaluation to `out_dir/progress.csv`."""
 
     def __init__(self, out_dir: Path, agents: Sequence[tuple[str, int]], metric_names: Sequence[str],
-                 row_agents: Sequence[int], keep_until: Optional[int] = None, write: bool = True):
+                 row_agents: Sequence[int], keep_until: Optional[int] = None, write: bool = True,
+                 eval_columns: Sequence[str] = EVAL_COLUMNS, eval_cells: Callable = evaluation_cells):
         """A new log of a row per (game, seed) of `agents`, each played by agent `row_agents[i]`
         (training statistics are that agent's); or, with `keep_until` (a resumed run's update),
         the existing rows up to that update, rewritten without the rows a killed run logged after
-        its checkpoint."""
+        its checkpoint. `eval_cells(evaluation, i, game)` gives row i's `eval_columns`."""
         self.csv_path = Path(out_dir) / "progress.csv"
         self.agents, self.metric_names, self.rows, self.write = list(agents), tuple(metric_names), [], write
-        self.row_agents = list(row_agents)
-        self.columns = COMMON_COLUMNS + self.metric_names
+        self.row_agents, self.eval_cells = list(row_agents), eval_cells
+        self.columns = HEAD_COLUMNS + tuple(eval_columns) + TRAIN_COLUMNS + self.metric_names
         if not write:
             return
         if keep_until is not None:
@@ -66,24 +84,18 @@ class ProgressLog:
 
     def add(self, update: int, step: int, wall_s: float, train_s: float, evaluation, totals: dict,
             host_metrics: dict) -> list[dict]:
-        """Rows for one evaluation: `evaluation` an `Evaluation` of (num_rows, eval_envs) arrays;
-        `totals` each metric's (num_agents,) sum over the updates since the last evaluation."""
-        greedy, sampled = np.asarray(evaluation.greedy_return), np.asarray(evaluation.sampled_return)
-        ended = np.concatenate([np.asarray(evaluation.greedy_ended), np.asarray(evaluation.sampled_ended)], axis=1)
+        """Rows for one evaluation: `evaluation` what `eval_cells` reads (an `Evaluation` of
+        (num_rows, eval_envs) arrays); `totals` each metric's (num_agents,) sum over the updates
+        since the last evaluation."""
         n = totals.get("updates", 0)
         rows = []
         num_agents = len(set(self.row_agents))
         for i, (game, seed) in enumerate(self.agents):
             a = self.row_agents[i]
             episodes = float(totals["finished_episodes"][a]) if n else 0.0
-            mean = float(sampled[i].mean())
             row = {"game": game, "seed": seed, "step": step, "update": update, "wall_s": round(wall_s, 2),
                    "env_steps_per_s": round(step * num_agents / train_s, 1) if train_s else math.nan,
-                   "eval_mean_return": mean, "eval_std": float(sampled[i].std()),
-                   "eval_greedy_return": float(greedy[i].mean()), "eval_greedy_std": float(greedy[i].std()),
-                   "eval_sampled_return": mean, "eval_sampled_std": float(sampled[i].std()),
-                   "eval_ended_frac": float(ended[i].mean()), "random_mean_return": baseline(game)[0],
-                   "normalized_score": normalized(game, mean),
+                   **self.eval_cells(evaluation, i, game),
                    "train_episode_return": (float(totals["finished_return_sum"][a]) / episodes
                                             if episodes else math.nan),
                    "train_episodes": int(episodes)}

@@ -23,7 +23,7 @@ import jax.numpy as jnp
 import numpy as np
 from tqdm import tqdm
 
-from octax_gym.train import figure, report
+from octax_gym.train import figure, report, selfplay
 from octax_gym.train.algorithm import make_trainer
 from octax_gym.train.checkpoints import Checkpoints, host_values, save_agents
 from octax_gym.train.config import TrainConfig
@@ -32,6 +32,7 @@ from octax_gym.train.evaluate import make_evaluate
 from octax_gym.train.log import ProgressLog
 from octax_gym.train.many import agent_keys, init_agents, over_agents
 from octax_gym.train.parallel import DataParallel
+from octax_gym.train.seats import SeatLanes
 
 
 def train(config: TrainConfig, out_dir, *, roms: Optional[Sequence] = None, progress: bool = True,
@@ -48,20 +49,29 @@ def train(config: TrainConfig, out_dir, *, roms: Optional[Sequence] = None, prog
     config.check()
     out_dir = Path(out_dir)
     writer = jax.process_index() == 0  # in a multi-process run, process 0 alone writes files
-    lanes = Lanes(config.games, dict(config.env_overrides), config.eval_noop_max, roms)  # refuses a bad mix
+    if config.selfplay:  # both seats of one two-player game as lanes (seats.py)
+        lanes = SeatLanes(config.games, dict(config.env_overrides), config.eval_noop_max, roms)
+    else:
+        lanes = Lanes(config.games, dict(config.env_overrides), config.eval_noop_max, roms)  # refuses a bad mix
     out_dir.mkdir(parents=True, exist_ok=True)
     trainer = make_trainer(config, lanes)
     rows = config.agents  # (game, seed) of each evaluation row
     num_agents = len(config.agent_names)
     options = lanes.compiler_options  # every jit that steps the env takes its platform's options
     eval_steps = config.eval_max_steps or int(np.asarray(lanes.params.max_episode_steps).max())
-    evaluate_rows = over_agents(make_evaluate(lanes, trainer, config.eval_envs, eval_steps), len(rows), config.agent_map)
     row_agents = np.asarray(config.row_agents)
-    if config.multitask:  # each seed's one agent plays every game's evaluation
+    log_columns = {}
+    if config.selfplay:  # matches against random and scripted players, on the host (selfplay.py)
+        evaluate = selfplay.make_evaluate(lanes, trainer.network, config.eval_envs, eval_steps)
+        log_columns = {"eval_columns": selfplay.EVAL_COLUMNS, "eval_cells": selfplay.evaluation_cells}
+    elif config.multitask:  # each seed's one agent plays every game's evaluation
+        evaluate_rows = over_agents(make_evaluate(lanes, trainer, config.eval_envs, eval_steps), len(rows),
+                                    config.agent_map)
         evaluate = jax.jit(lambda params, keys, games: evaluate_rows(
             jax.tree.map(lambda x: x[row_agents], params), keys, games), compiler_options=options)
     else:
-        evaluate = jax.jit(evaluate_rows, compiler_options=options)
+        evaluate = jax.jit(over_agents(make_evaluate(lanes, trainer, config.eval_envs, eval_steps), len(rows),
+                                       config.agent_map), compiler_options=options)
 
     if not resume and writer:
         (out_dir / "config.json").write_text(json.dumps(
@@ -97,10 +107,10 @@ def train(config: TrainConfig, out_dir, *, roms: Optional[Sequence] = None, prog
           f"agent{'s' * (num_agents > 1)} x {config.num_envs} envs x {config.num_steps} steps, "
           f"{config.num_updates} updates)")
 
-    title = (f"{'multi-task ' * config.multitask}{trainer.name}, {len(config.games)} game{'s' * (len(config.games) > 1)} x {config.num_seeds} "
+    title = (f"{'multi-task ' * config.multitask}{'self-play ' * config.selfplay}{trainer.name}, {len(config.games)} game{'s' * (len(config.games) > 1)} x {config.num_seeds} "
              f"seed{'s' * (config.num_seeds > 1)} ({config.num_envs} envs x {config.num_steps} steps)")
     log = ProgressLog(out_dir, rows, trainer.metric_names, row_agents,
-                      keep_until=None if start_at is None else start_at["update"], write=writer)
+                      keep_until=None if start_at is None else start_at["update"], write=writer, **log_columns)
     bar = tqdm(total=config.num_updates * config.batch_size * num_agents, unit="step", unit_scale=True,
                disable=not progress or not writer, desc=f"{trainer.name} x{num_agents}")
     if start_at is not None:
@@ -148,9 +158,7 @@ def _updates(config: TrainConfig, update, runner, data, evaluated, checkpoints: 
     """The updates, with `evaluated(i, runner, train_s, totals)` every `eval_every` steps and at
     both ends, and a checkpoint every `checkpoint_every` updates. Returns the runner and the
     seconds spent in updates."""
-    eval_interval = config.num_updates
-    if config.eval_every:
-        eval_interval = max(1, round(config.eval_every / config.batch_size))
+    eval_interval = config.eval_interval
     train_s, totals, first = 0.0, {}, 0
     if start_at is not None:
         first, train_s, totals = start_at["update"], start_at["train_s"], start_at["totals"]

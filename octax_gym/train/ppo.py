@@ -3,8 +3,15 @@
 The paper's settings are `presets.PAPER["ppo"]`: 512 envs, 32-step rollouts, 4 epochs of 32
 minibatches, Adam 5e-4, GAE 0.95, clip 0.2 (the value loss clipped too, as CleanRL's Atari PPO
 and the paper's Rejax-based code do), value 0.5, entropy 0.01, gamma 0.99, grad norm 0.5. Logits
-are masked to the agent's game's actions (networks.masked) before every sample, log-prob,
-entropy and argmax, so an action the game does not take is never drawn and costs no entropy.
+are masked to the actions open to each lane (the lanes' `legal_mask`: a one-player game's own
+actions; in a turn-based two-player game, only no-op for the seat not to move) before every
+sample, log-prob, entropy and argmax, so a closed action is never drawn and costs no entropy.
+
+Each sample carries a weight in the loss (`OldPolicy.weight`): 1 for the agent's own samples,
+which is every sample of ppo and multitask runs and of self-play without a pool (their loss
+takes the plain means, bit for bit those of the unweighted loss); 0 where self-play's pool put a
+past self on the seat (selfplay.py): another policy made those actions, so they train nothing,
+while the same env's other seat trains as usual.
 """
 
 from __future__ import annotations
@@ -26,8 +33,9 @@ METRICS = ("pg_loss", "v_loss", "entropy", "approx_kl", "clip_frac", "learning_r
 class OldPolicy(NamedTuple):
     """What the rollout's policy said at each step, kept for the ratio and the value clip."""
 
-    log_prob: jax.Array  # (num_envs,) float32, of the action taken
-    value: jax.Array  # (num_envs,) float32, the critic's
+    log_prob: jax.Array  # (lanes,) float32, of the action taken
+    value: jax.Array  # (lanes,) float32, the critic's
+    weight: jax.Array  # (lanes,) float32: 1 for the agent's own action, 0 for a past self's (self-play's pool)
 
 
 def make_trainer(config: TrainConfig, lanes: Lanes) -> Trainer:
@@ -35,6 +43,8 @@ def make_trainer(config: TrainConfig, lanes: Lanes) -> Trainer:
 
     `config.multitask`: one agent over all the games, its lanes' games (and with `game_input` the
     game's one-hot, `ActorCritic(num_games=G)`) read per lane; otherwise one agent, one game.
+    `config.selfplay`: one agent on both seats of `lanes` (seats.SeatLanes), its pool of past
+    selves (selfplay.py) drawn before each rollout and playing the seats it picks.
     """
     num_games = len(lanes.games) if config.multitask and config.game_input else 0
     network, optimizer = ActorCritic(num_games=num_games), shared.make_optimizer(config)
@@ -43,39 +53,54 @@ def make_trainer(config: TrainConfig, lanes: Lanes) -> Trainer:
     def net_input(obs, game):
         return (obs, jnp.broadcast_to(game, obs.shape[:1])) if num_games else obs
 
-    def apply(params, obs, game):
+    def apply(params, obs, game, legal):
         logits, value = network.apply(params, net_input(obs, game))
-        return masked(logits, legal_of[game]), value
+        return masked(logits, legal), value
 
-    def act(params, key, obs, game, _):
-        logits, value = apply(params, obs, game)
+    def act(params, key, obs, game, legal, opponent):
+        logits, value = apply(params, obs, game, legal)
         action = jax.random.categorical(key, logits)
+        weight = jnp.ones(action.shape, jnp.float32)
+        if opponent is not None:  # self-play's pool: a past self's action on the lanes it plays, weight 0
+            past_params, past = opponent
+            past_action = jax.random.categorical(jax.random.fold_in(key, 1), apply(past_params, obs, game, legal)[0])
+            action, weight = jnp.where(past, past_action, action), jnp.where(past, 0.0, weight)
         log_prob = jnp.take_along_axis(jax.nn.log_softmax(logits), action[:, None], 1)[:, 0]
-        return action, OldPolicy(log_prob, value)
+        return action, OldPolicy(log_prob, value, weight)
 
     def critic(params, obs, game):
-        return apply(params, obs, game)[1]
+        return network.apply(params, net_input(obs, game))[1]
 
     rollout = shared.make_rollout(config, lanes, act, critic)
     learn = shared.make_learn(config, optimizer, lambda params, minibatch: ppo_loss(params, apply, config, minibatch))
 
     def collect(runner: shared.RunnerState):
-        runner, traj = rollout(runner)
+        opponent = None
+        if config.selfplay and config.pool:
+            from octax_gym.train import selfplay
+
+            runner, opponent = selfplay.draw_opponent(config, runner)
+        runner, traj = rollout(runner, opponent)
         old = traj.policy_out
         last_value = critic(runner.params, runner.obs, runner.game)
         advantages, targets = gae(traj.reward, traj.done, old.value, last_value, config.gamma, config.gae_lambda)
-        games = jnp.broadcast_to(runner.game, traj.action.shape)  # each sample's game: its mask (and input)
-        batch = (traj.obs, games, traj.action, old.log_prob, old.value, advantages, targets)
+        games = jnp.broadcast_to(runner.game, traj.action.shape)  # each sample's game: its input (multitask)
+        batch = (traj.obs, games, traj.legal, traj.action, old.log_prob, old.value, advantages, targets, old.weight)
         return runner, batch, shared.episode_totals(traj)
 
     def greedy(params, key, obs, game):
-        return jnp.argmax(apply(params, obs, game)[0], axis=1).astype(jnp.int32)
+        return jnp.argmax(apply(params, obs, game, legal_of[game])[0], axis=1).astype(jnp.int32)
 
     def sampled(params, key, obs, game):
-        return jax.random.categorical(key, apply(params, obs, game)[0]).astype(jnp.int32)
+        return jax.random.categorical(key, apply(params, obs, game, legal_of[game])[0]).astype(jnp.int32)
 
-    return Trainer("PPO", network, shared.make_init(config, lanes, network, optimizer, net_input), collect, learn,
-                   greedy, sampled, METRICS, lambda i: {"learning_rate": config.learning_rate_at(i)})
+    init = shared.make_init(config, lanes, network, optimizer, net_input)
+    if config.selfplay and config.pool:
+        from octax_gym.train import selfplay
+
+        init = selfplay.with_pool(config, init)
+    return Trainer("PPO", network, init, collect, learn, greedy, sampled, METRICS,
+                   lambda i: {"learning_rate": config.learning_rate_at(i)})
 
 
 def gae(reward: jax.Array, done: jax.Array, value: jax.Array, last_value: jax.Array, gamma: float, lam: float):
@@ -95,25 +120,36 @@ def gae(reward: jax.Array, done: jax.Array, value: jax.Array, last_value: jax.Ar
 
 
 def ppo_loss(params, apply, config: TrainConfig, minibatch):
-    """The clipped surrogate, the (clipped) value loss and the entropy bonus, over masked logits
-    (`apply(params, obs, game) -> (masked logits, values)`)."""
-    obs, game, action, old_log_prob, old_value, advantage, target = minibatch
-    logits, value = apply(params, obs, game)
+    """The clipped surrogate, the (clipped) value loss and the entropy bonus, over logits masked to
+    each sample's legal actions (`apply(params, obs, game, legal) -> (masked logits, values)`),
+    every mean (the advantages' normalisation too) weighted by the samples' weights."""
+    obs, game, legal, action, old_log_prob, old_value, advantage, target, weight = minibatch
+    logits, value = apply(params, obs, game, legal)
+    # Only a pool's past selves weigh 0: without one every weight is 1, and the plain means are
+    # kept, so that ppo and multitask runs stay bit for bit what they were (the weighted form of
+    # the same means differs in the last float bits, measured).
+    weighted = config.selfplay and config.pool > 0
+    total = jnp.maximum(weight.sum(), 1.0)  # a minibatch of past selves' samples alone trains nothing
+
+    def mean(x):
+        return (x * weight).sum() / total if weighted else x.mean()
+
     log_probs = jax.nn.log_softmax(logits)
     log_prob = jnp.take_along_axis(log_probs, action[:, None], 1)[:, 0]
-    entropy = -(jnp.exp(log_probs) * log_probs).sum(-1).mean()
+    entropy = -mean((jnp.exp(log_probs) * log_probs).sum(-1))
     log_ratio = log_prob - old_log_prob
     ratio = jnp.exp(log_ratio)
-    advantage = (advantage - advantage.mean()) / (advantage.std() + 1e-8)
+    centred = advantage - mean(advantage)
+    advantage = centred / ((jnp.sqrt(mean(jnp.square(centred))) if weighted else advantage.std()) + 1e-8)
     clipped = jnp.clip(ratio, 1 - config.clip_eps, 1 + config.clip_eps)
-    pg_loss = -jnp.minimum(ratio * advantage, clipped * advantage).mean()
+    pg_loss = -mean(jnp.minimum(ratio * advantage, clipped * advantage))
     v_loss = jnp.square(value - target)
     if config.clip_value_loss:
         v_clipped = old_value + jnp.clip(value - old_value, -config.clip_eps, config.clip_eps)
         v_loss = jnp.maximum(v_loss, jnp.square(v_clipped - target))
-    v_loss = 0.5 * v_loss.mean()
+    v_loss = 0.5 * mean(v_loss)
     loss = pg_loss + config.vf_coef * v_loss - config.ent_coef * entropy
     stats = {"pg_loss": pg_loss, "v_loss": v_loss, "entropy": entropy,
-             "approx_kl": ((ratio - 1) - log_ratio).mean(),
-             "clip_frac": (jnp.abs(ratio - 1) > config.clip_eps).mean()}
+             "approx_kl": mean((ratio - 1) - log_ratio),
+             "clip_frac": mean(jnp.abs(ratio - 1) > config.clip_eps)}
     return loss, stats

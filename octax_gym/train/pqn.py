@@ -24,9 +24,10 @@ METRICS = ("td_loss", "q_mean", "target_mean", "epsilon", "learning_rate")
 
 
 def epsilon_greedy(q_values: jax.Array, key: jax.Array, epsilon, legal: jax.Array) -> jax.Array:
-    """argmax of the legal Q-values, or with probability epsilon a uniformly drawn legal action, per row."""
+    """argmax of the legal Q-values, or with probability epsilon a uniformly drawn legal action, per
+    row; `legal` (A,) or a row per Q-value row, a game's first actions (`Lanes.legal_mask`)."""
     explore_key, action_key = jax.random.split(key)
-    count = legal.sum()  # the game's actions are its first `count`
+    count = legal.sum(-1)  # the game's actions are its first `count` (per row: the same draws as one count)
     random_action = jax.random.randint(action_key, q_values.shape[:1], 0, count)
     explore = jax.random.uniform(explore_key, q_values.shape[:1]) < epsilon
     return jnp.where(explore, random_action, jnp.argmax(masked(q_values, legal), axis=1)).astype(jnp.int32)
@@ -37,9 +38,9 @@ def make_trainer(config: TrainConfig, lanes: Lanes) -> Trainer:
     network, optimizer = QNetwork(), shared.make_optimizer(config)
     legal_of = jnp.asarray(lanes.legal)
 
-    def explore(params, key, obs, game, epsilon):
+    def explore(params, key, obs, game, legal, epsilon):
         q_values = network.apply(params, obs)
-        return epsilon_greedy(q_values, key, epsilon, legal_of[game]), masked(q_values, legal_of[game]).max(axis=1)
+        return epsilon_greedy(q_values, key, epsilon, legal), masked(q_values, legal).max(axis=1)
 
     def max_q(params, obs, game):
         return masked(network.apply(params, obs), legal_of[game]).max(axis=1)

@@ -24,6 +24,8 @@ PAPER = {
                 epsilon_fraction=0.1, eval_epsilon=0.005),
 }
 PAPER["multitask"] = PAPER["ppo"]  # the multi-task agent learns with PPO
+# Self-play learns with PPO too (the paper has no self-play: its settings, with pure self-play's pool 0).
+PAPER["selfplay"] = dict(PAPER["ppo"], pool=0, pool_prob=0.5)
 # Offline (not the paper's): an update draws 1,024 transitions and takes 8 Adam steps of 128 on them,
 # 2,000 steps in all (the batch and steps of the offline example it replaces); one setting for both presets.
 _OFFLINE = dict(total_steps=256_000, num_envs=128, num_steps=8, update_epochs=1, num_minibatches=8,

@@ -43,9 +43,10 @@ def test_lanes_alternate_games_and_masks_follow_them():
     assert np.asarray(runner.game).tolist() == [0, 1, 0, 1]
     assert np.asarray(runner.env_state.game).tolist() == [0, 1, 0, 1]
     runner, batch, _ = jax.jit(trainer.collect)(runner)
-    actions, games = np.asarray(batch[2]), np.asarray(batch[1])
+    games, legal, actions = np.asarray(batch[1]), np.asarray(batch[2]), np.asarray(batch[3])
     assert (actions[games == 0] < 2).all() and (actions[games == 1] < 4).all()  # Airplane: 2 actions, Deep8: 4
     assert (actions[games == 1] >= 2).any()
+    assert (legal.sum(-1) == np.where(games == 0, 2, 4)).all()  # each lane's mask, its game's (Lanes.legal_mask)
 
 
 def test_lanes_must_divide_among_the_games(capsys):

@@ -1,0 +1,178 @@
+"""Self-play, the trainer's `selfplay` configuration, on the tiny two-player test games
+(tests/two_player_games.py): TwoCounters (simultaneous, with a scripted player) trains a TINY
+run; TakeTurns (turn-based) checks that the rollout takes its legal masks from the env's state."""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+import pytest
+
+pytest.importorskip("flax")
+from two_player_games import TAKE_TURNS, TWO_COUNTERS  # noqa: E402
+
+from octax_gym.train import preset, selfplay, train  # noqa: E402
+from octax_gym.train.algorithm import make_trainer  # noqa: E402
+from octax_gym.train.seats import SeatLanes  # noqa: E402
+
+# tiny_run.TINY's settings as a config (TINY is flags; the test games are GameSpecs, not ids)
+TINY = dict(num_envs=4, num_steps=8, num_minibatches=2, update_epochs=1, total_steps=192, eval_every=64,
+            eval_envs=2, eval_max_steps=30, env_overrides=(("max_episode_steps", 20),), checkpoint_every=2)
+STEPS = [0, 64, 128, 192]
+
+
+def tiny(**overrides):
+    return preset("cpu", "selfplay", games=(TWO_COUNTERS,), **{**TINY, **overrides})
+
+
+@pytest.fixture(scope="module")
+def run(two_counters_rom, tmp_path_factory):
+    out = tmp_path_factory.mktemp("selfplay") / "run"
+    return train(tiny(save_at_evals=True), out, roms=[two_counters_rom], progress=False)
+
+
+def test_a_row_per_evaluation_with_the_matches_columns(run):
+    rows = run["rows"]
+    assert [r["step"] for r in rows] == STEPS and {r["game"] for r in rows} == {"TwoCounters"}
+    header = run["csv"].read_text().splitlines()[0].split(",")
+    assert all(column in header for column in selfplay.EVAL_COLUMNS) and "normalized_score" not in header
+    for row in rows:
+        for policy in selfplay.POLICIES:
+            for opponent in selfplay.OPPONENTS:  # TwoCounters has a scripted player: every cell is a number
+                rates = [row[f"{policy}_vs_{opponent}_{stat}"] for stat in ("win", "draw", "loss")]
+                assert math.isclose(sum(rates), 1.0) and all(0 <= r <= 1 for r in rates)
+        # the scripted player holds its 2-key: against it an agent's return is its own count, the margin below it
+        assert row["eval_mean_return"] - row["sampled_vs_scripted_margin"] >= 0
+
+
+def test_params_change_and_agents_are_saved_as_the_loop_saves_them(run):
+    from octax_gym import jax_policy
+    from octax_gym.play.agents import load_agent
+
+    folder = run["out_dir"] / "agents"
+    first, last = (jax_policy.load_params(folder / f"TwoCounters-seed0{s}.msgpack") for s in ("-step0", ""))
+    assert any(not np.array_equal(a, b) for a, b in zip(jax.tree.leaves(first), jax.tree.leaves(last)))
+    assert jax_policy.describe(last).channels == 5  # 4 frames and the player plane
+    agent = load_agent(folder / "TwoCounters-seed0.msgpack", num_actions=3)  # octax-gym play's loader
+    assert agent(np.zeros((5, 32, 64), np.uint8)) in (0, 1, 2)
+
+
+def test_the_same_seed_gives_the_same_run(run, two_counters_rom, tmp_path):
+    again = train(tiny(save_at_evals=True), tmp_path, roms=[two_counters_rom], progress=False)
+    timing = ("wall_s", "env_steps_per_s")
+    assert [{k: v for k, v in r.items() if k not in timing} for r in again["rows"]] == \
+           [{k: v for k, v in r.items() if k not in timing} for r in run["rows"]]
+    for a, b in zip(jax.tree.leaves(again["final_params"]), jax.tree.leaves(run["final_params"])):
+        np.testing.assert_array_equal(a, b)
+
+
+def _collect(config, game, rom):
+    lanes = SeatLanes((game,), dict(config.env_overrides), roms=[rom])
+    trainer = make_trainer(config, lanes)
+    runner = jax.jit(trainer.init)(jax.random.key(0), jnp.int32(0))
+    return lanes, trainer, runner, jax.jit(trainer.collect)(runner)
+
+
+def test_a_past_self_plays_one_seat_of_an_env_and_its_samples_weigh_zero(two_counters_rom):
+    config = tiny(pool=2, pool_prob=1.0)
+    _, trainer, _, (after, batch, _) = _collect(config, TWO_COUNTERS, two_counters_rom)
+    weight = np.asarray(batch[-1]).reshape(config.num_steps, config.num_envs, 2)
+    # every env (pool_prob 1): one seat, the same for the whole rollout, played by the past self
+    assert (weight.sum(-1) == 1).all() and (weight == weight[:1]).all()
+    assert int(after.pool.count) == 1  # the first rollout's snapshot: the initial params
+
+    # A weight-0 sample trains nothing: whatever its action and advantage, the same gradient.
+    from octax_gym.train.ppo import ppo_loss
+    from octax_gym.train.networks import masked
+
+    flat = jax.tree.map(lambda x: x.reshape((-1,) + x.shape[2:]), batch)
+    changed = list(flat)
+    zero = flat[-1] == 0
+    changed[3] = jnp.where(zero, (flat[3] + 1) % 3, flat[3])  # actions
+    changed[6] = jnp.where(zero, flat[6] + 100.0, flat[6])  # advantages
+
+    def apply(params, obs, game, legal):
+        logits, value = trainer.network.apply(params, obs)
+        return masked(logits, legal), value
+
+    def grad(minibatch):
+        return jax.grad(lambda p: ppo_loss(p, apply, config, minibatch)[0])(after.params)
+
+    for a, b in zip(jax.tree.leaves(grad(tuple(flat))), jax.tree.leaves(grad(tuple(changed)))):
+        np.testing.assert_allclose(a, b, rtol=1e-5, atol=1e-7)
+
+
+def test_the_pool_takes_a_snapshot_at_each_evaluations_update(two_counters_rom):
+    config = tiny(pool=2, pool_prob=1.0)
+    lanes = SeatLanes((TWO_COUNTERS,), dict(config.env_overrides), roms=[two_counters_rom])
+    trainer = make_trainer(config, lanes)
+    runner = jax.jit(trainer.init)(jax.random.key(0), jnp.int32(0))
+    draw = jax.jit(lambda r: selfplay.draw_opponent(config, r)[0])
+    counts = []
+    for update in range(5):  # eval_interval = 2 updates: snapshots at updates 0, 2, 4 into a ring of 2
+        runner = draw(runner._replace(updates=jnp.int32(update),
+                                      params=jax.tree.map(lambda x: x + update, runner.params)))
+        counts.append(int(runner.pool.count))
+    assert counts == [1, 1, 2, 2, 2]
+    leaf = lambda tree: np.asarray(jax.tree.leaves(tree)[0])  # noqa: E731
+    base = leaf(jax.jit(trainer.init)(jax.random.key(0), jnp.int32(0)).params)
+    # slot 0 holds update 4's params (base + 0+1+2+3+4), slot 1 update 2's (base + 0+1+2)
+    np.testing.assert_allclose(leaf(runner.pool.params)[0], base + 10, rtol=1e-6)
+    np.testing.assert_allclose(leaf(runner.pool.params)[1], base + 3, rtol=1e-6)
+
+
+def test_turn_based_legal_masks_come_from_the_state_and_are_honoured(take_turns_rom):
+    config = dataclasses.replace(tiny(), games=(TAKE_TURNS,))
+    lanes, _, runner, (_, batch, _) = _collect(config, TAKE_TURNS, take_turns_rom)
+    legal, action = np.asarray(batch[2]), np.asarray(batch[3])  # (T, 2N, ACTIONS), (T, 2N)
+    assert np.take_along_axis(legal, action[..., None], -1).all()  # never a closed action
+    per_env = legal.reshape(config.num_steps, config.num_envs, 2, -1)
+    # one seat moves: it has its key (action 1), the other no-op alone; actions past the game's 2 never
+    assert (per_env[..., 1].sum(-1) == 1).all() and not per_env[..., 2:].any()
+    assert (per_env[..., 0]).all()
+    # the masks are the env's own
+    expected = jax.vmap(lanes.env.legal_action_mask)(runner.env_state).reshape(2 * config.num_envs, -1)
+    np.testing.assert_array_equal(legal[0, :, :2], expected)
+
+
+@pytest.mark.parametrize("flags, message", [
+    (["selfplay", "--game", "Airplane"], "selfplay: Airplane is a one-player game; two-player games: Cycles"),
+    (["selfplay", "--games", "Cycles,Duel"], "selfplay trains on one two-player game; got games Cycles, Duel"),
+    (["selfplay", "--game", "Cycles", "--eval-envs", "3"], "eval_envs = 3 must be even"),
+    (["selfplay", "--game", "Cycles", "--pool-prob", "2"], "pool_prob must be in [0, 1], got 2.0"),
+    (["selfplay", "--game", "Cycles", "--pool", "-1"], "pool must be an int >= 0, got -1"),
+    (["ppo", "--game", "Airplane", "--pool", "2"], "--pool: not a setting of ppo (of selfplay)"),
+])
+def test_bad_selfplay_flags_are_refused_by_name(flags, message, capsys, tmp_path, monkeypatch):
+    from octax_gym.cli import main
+
+    monkeypatch.chdir(tmp_path)
+    assert main(["train", *flags, "--no-progress"]) == 1
+    assert message in capsys.readouterr().err
+    assert not list(tmp_path.iterdir())
+
+
+def test_the_presets_have_selfplay():
+    for name in ("cpu", "paper"):
+        config = preset(name, "selfplay", games=("Cycles",), pool=4)
+        assert config.selfplay and config.pool == 4 and config.clip_eps == preset(name, "ppo").clip_eps
+        assert config.num_envs == preset(name, "ppo").num_envs
+
+
+@pytest.mark.slow
+def test_the_cli_trains_cycles_and_play_loads_its_agent(tmp_path):
+    """`octax-gym train selfplay --game Cycles` end to end (a real game: its compile is the minute)."""
+    from octax_gym.cli import main
+    from octax_gym.play.agents import load_agent
+    from tiny_run import TINY as FLAGS
+
+    out = tmp_path / "run"
+    assert main(["train", "selfplay", "--game", "Cycles", "--pool", "2", *FLAGS, "--out-dir", str(out)]) == 0
+    lines = (out / "progress.csv").read_text().splitlines()
+    assert len(lines) == 1 + 4 and "greedy_vs_scripted_win" in lines[0]
+    agent = load_agent(out / "agents" / "Cycles-seed0.msgpack", num_actions=5)
+    assert agent(np.zeros((5, 32, 64), np.uint8)) in range(5)
