@@ -27,21 +27,28 @@ def test_bad_usage_names_the_choices(capsys, tmp_path):
     assert "--count must be >= 1, got 0" in capsys.readouterr().err
 
 
-def test_the_same_seed_writes_the_same_archive(tmp_path, capsys):
-    for run in ("a", "b"):
-        assert main(["generate", "--family", "paddle", "--count", "3", "--seed", "5",
-                     "--out", str(tmp_path / run), *TINY]) == 0
+def _run(folder, seed=5):
+    return main(["generate", "--family", "paddle", "--count", "3", "--seed", str(seed), "--out", str(folder), *TINY])
+
+
+def test_a_run_writes_sources_roms_and_the_archive(tmp_path, capsys):
+    assert _run(tmp_path) == 0
     assert "of 3 accepted" in capsys.readouterr().out
-    first = (tmp_path / "a" / archive.ARCHIVE).read_bytes()
-    assert first == (tmp_path / "b" / archive.ARCHIVE).read_bytes()
-    games = archive.read(tmp_path / "a")["games"]
+    games = archive.read(tmp_path)["games"]
     assert [g["name"] for g in games] == ["paddle-s5-0000", "paddle-s5-0001", "paddle-s5-0002"]
     for game in games:
         assert set(archive.REQUIRED) <= set(game)
-        assert (tmp_path / "a" / game["rom"]).read_bytes()  # the ROM and its source are beside it
-        assert (tmp_path / "a" / game["source"]).read_text().startswith("\n####")
+        assert (tmp_path / game["rom"]).read_bytes()  # the ROM and its source are beside it
+        assert (tmp_path / game["source"]).read_text().startswith("\n####")
         assert game["split"] == ("test" if game["params"]["speed_x"] == 3 else "train")
         assert game["accepted"] == (game["reasons"] == [])
+        assert game["random_score"] is not None and game["reference_score"] is not None
+
+
+def test_the_same_seed_writes_the_same_archive(tmp_path):
+    # the same programs as the test above: the second and third runs compile nothing new
+    assert _run(tmp_path / "a") == 0 and _run(tmp_path / "b") == 0
+    assert (tmp_path / "a" / archive.ARCHIVE).read_bytes() == (tmp_path / "b" / archive.ARCHIVE).read_bytes()
 
 
 def test_judge_names_a_repeat_and_a_program_that_does_not_assemble():

@@ -8,7 +8,7 @@ from pathlib import Path
 
 import pytest
 
-from octax_core.generate import chat, llm, prompt
+from octax_core.generate import chat, filters, llm, prompt
 from octax_gym.cli import main
 
 REPO = Path(__file__).resolve().parents[2]
@@ -59,6 +59,12 @@ def server():
 
 def test_a_broken_program_is_repaired_and_archived(server, tmp_path, monkeypatch, capsys):
     monkeypatch.setenv("OCTAX_TEST_KEY", "sk-test")
+    judged = []
+
+    def fake_check(specs, roms, settings):  # the filters are tests/generate/test_filters.py's
+        judged.extend(roms)
+        return [filters.Verdict(("made up",), 0.0, 0.0, 0.0) for _ in specs]
+    monkeypatch.setattr(filters, "check", fake_check)
     out = tmp_path / "llm"
     assert main(["generate", "--llm-url", server.url, "--model", "tiny", "--description", "dodge falling rocks",
                  "--count", "1", "--repairs", "2", "--api-key-env", "OCTAX_TEST_KEY", "--trace-steps", "100",
@@ -79,6 +85,7 @@ def test_a_broken_program_is_repaired_and_archived(server, tmp_path, monkeypatch
     assert game["registers"] == {"score": 5, "lives": 6, "end": [14, 1]}
     assert game["action_keys"] == [1, 4, 6] and game["registers_found"].startswith("stated in the reply")
     assert (out / "llm-0000.ch8").read_bytes() == (REPO / "roms" / "dodge.ch8").read_bytes()
+    assert judged == [(REPO / "roms" / "dodge.ch8").read_bytes()] and game["reasons"] == ["made up"]
 
 
 def test_without_repairs_the_assembler_message_is_the_reason(server, tmp_path):
