@@ -26,7 +26,6 @@ def main(argv=None) -> int:
     import cv2
     import jax
     import jax.numpy as jnp
-    import numpy as np
 
     import octax_core
     from octax_core.emulator.state import screen_pixels
