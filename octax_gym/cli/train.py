@@ -4,6 +4,7 @@
     octax-gym train pqn --game Brix --seed 3 --total-steps 1000000
     octax-gym train ppo --preset paper --games octax16 --num-seeds 3              # the paper's table, on a GPU
     octax-gym train ppo --resume runs/ppo                                           # a run cut short, continued
+    octax-gym train ppo --devices all --coordinator node0:29500 --num-processes 2 --process-id $RANK
     octax-gym train multitask --games Airplane,Brix,Deep8,Filter --num-envs 64       # one agent for all four
     octax-gym train selfplay --game Cycles --pool 4                                  # both seats, past selves
     octax-gym train bc --dataset octax/Flak/expert-v0 --num-seeds 2                  # offline, on a dataset
@@ -103,6 +104,11 @@ def add_commands(commands: argparse._SubParsersAction) -> None:
                            help="an env option for every game (octax_core.make); default: the game's")
     train.add_argument("--devices", default=None, metavar="all",
                        help="all: every agent's envs split over every device (data-parallel); default one device")
+    train.add_argument("--coordinator", default=None, metavar="HOST:PORT",
+                       help="with --devices all over several processes: process 0's address "
+                            "(octax_gym.distributed.initialize; without it, SLURM or torchrun-style variables)")
+    train.add_argument("--num-processes", type=int, default=None, help="processes in a multi-process run")
+    train.add_argument("--process-id", type=int, default=None, help="this process's rank in a multi-process run")
     train.add_argument("--agent-map", default=None, choices=("auto", "vmap", "map"),
                        help="how agents share the program: vmap (batched, for a GPU), map (one after another: "
                             "bit for bit a lone run's), auto (map on a CPU, vmap elsewhere; the default)")
@@ -153,6 +159,14 @@ def config_from_args(args: argparse.Namespace):
 
 
 def _cmd_train(args: argparse.Namespace) -> int:
+    distributed = (args.coordinator, args.num_processes, args.process_id)
+    if any(value is not None for value in distributed):  # before anything computes with JAX
+        import octax_gym.distributed
+
+        try:
+            octax_gym.distributed.initialize(*distributed)
+        except octax_gym.distributed.DistributedInitError as exc:  # a start-up mistake, named: no traceback
+            raise ValueError(str(exc)) from None
     if args.resume is not None:
         config, out_dir = _resumed(args)
     else:

@@ -121,3 +121,53 @@ def test_a_game_without_a_reference_score_is_named_left_out_and_written_as_null(
     text = (tmp_path / "summary.json").read_text()
     strict = json.loads(text, parse_constant=lambda name: pytest.fail(f"summary.json holds {name}"))
     assert strict["games"]["Tetris"]["normalized_iqm"] is None
+
+
+def test_epsilon_decays_over_the_first_tenth_then_stays():
+    from octax_gym.train import preset
+
+    config = preset("cpu", "pqn", num_envs=8, num_steps=10, num_minibatches=2, total_steps=8 * 10 * 100)
+    assert float(config.epsilon(0)) == 1.0
+    assert float(config.epsilon(5)) == pytest.approx(1.0 - 0.95 * 0.5)
+    assert float(config.epsilon(10)) == pytest.approx(0.05)
+    assert float(config.epsilon(99)) == pytest.approx(0.05)
+
+
+def test_any_over_agents_is_shared_by_vmapped_agents_so_a_cond_stays_a_branch():
+    flags = np.array([[False, False], [False, True], [False, False]])
+    shared = many.over_agents(lambda f: many.any_over_agents(f, True), 3, "vmap")(flags)
+    assert shared.tolist() == [True, True, True]  # agent 1's truncation is every agent's predicate
+    assert many.over_agents(lambda f: many.any_over_agents(f, False), 1)(flags[1:2]).tolist() == [True]
+
+    def step(f):
+        return jax.lax.cond(many.any_over_agents(f, True), lambda: f.sum(), lambda: -1)
+
+    jaxpr = str(jax.make_jaxpr(many.over_agents(step, 3, "vmap"))(flags))
+    assert "cond[" in jaxpr and "select_n" not in jaxpr  # with a per-agent predicate vmap makes it a select
+    per_agent = str(jax.make_jaxpr(jax.vmap(lambda f: jax.lax.cond(f.any(), lambda: f.sum(), lambda: -1)))(flags))
+    assert "select_n" in per_agent
+
+
+def test_learn_passes_over_the_whole_rollout_each_epoch_and_counts_the_update():
+    from octax_gym.train import preset, rollout
+
+    config = preset("cpu", "ppo", num_envs=3, num_steps=4, num_minibatches=3, update_epochs=2, learning_rate=0.1,
+                    total_steps=12)
+    batch = jnp.arange(12.0).reshape(4, 3)  # (num_steps, lanes)
+
+    def loss(params, minibatch):
+        return jnp.mean((params["w"] - minibatch) ** 2), {"mean": minibatch.mean(), "size": minibatch.size}
+
+    optimizer = rollout.make_optimizer(config)
+    params = {"w": jnp.zeros(())}
+    runner = rollout.RunnerState(params, optimizer.init(params), None, None, None, jax.random.key(0), jnp.int32(0),
+                                 jnp.int32(0))
+    learned, stats = jax.jit(rollout.make_learn(config, optimizer, loss))(runner, batch)
+    # Every epoch splits all 12 samples into 3 minibatches of 4, so their means average to the batch's.
+    assert float(stats["mean"]) == pytest.approx(5.5) and float(stats["size"]) == 4
+    assert 0 < float(learned.params["w"]) <= 6 * 0.1 + 1e-6  # 6 Adam steps of at most lr each, towards 5.5
+    assert int(learned.updates) == 1
+    assert not np.array_equal(jax.random.key_data(learned.key), jax.random.key_data(runner.key))
+    # twice the lanes (self-play's two seats): the same minibatch count, each twice as large
+    _, stats = jax.jit(rollout.make_learn(config, optimizer, loss))(runner, jnp.arange(24.0).reshape(4, 6))
+    assert float(stats["size"]) == 8 and float(stats["mean"]) == pytest.approx(11.5)
