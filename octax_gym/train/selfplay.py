@@ -30,9 +30,9 @@ a one-player run has its returns):
   the opponent's); nan for an opponent the game does not have.
 * `eval_ended_frac`: the fraction of all those games that ended before the step cap.
 
-The Elo of an agent against the game's ladder of fixed rungs is `octax_core.env.ladder.play_ladder`'s
-(issue 41's `octax-gym evaluate`), run on a saved agent (`OUT/agents/<game>-seed<s>.msgpack`), not
-at every evaluation.
+The Elo of an agent against the game's ladder of fixed rungs is `octax-gym evaluate GAME --agent
+OUT/agents/<game>-seed<s>.msgpack --opponents ladder`'s (`octax_core.env.ladder.play_ladder`), run
+on a saved agent, not at every evaluation.
 """
 
 from __future__ import annotations
