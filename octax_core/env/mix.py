@@ -11,8 +11,9 @@ env resets to plus a few things looked up by its game index (`EnvState.game`): i
 speed (the machine's `profiles`: quirks the games share stay constants of the traced program,
 the others are read per machine, and each machine keeps its own frame clock, so a 15-instruction
 game and an 11-instruction one step together), its keys, whether its timers are frozen, its
-episode length, and its score, lives and end (`lax.switch` on the game: under `vmap` every
-game's functions run on every machine and the env's own is selected; they read a few registers).
+episode length, and its score, lives and end (`lax.switch` on the game's function: under `vmap`
+every distinct function runs on every machine and the env's own is selected; they read a few
+registers, and games sharing a function share its branch).
 
 `MixEnv` is `Env` with those pieces per game (`Env._transition`, `Env.autoreset`: one step, one
 autoreset), so an env reset with `game=i` plays, step for step, exactly what `make(games[i])`
@@ -151,19 +152,37 @@ class MixEnv(Env):
         return machine, screens
 
     def _score(self, machine: MachineState, game) -> jax.Array:
-        return jax.lax.switch(game, [lambda m, s=spec: jnp.asarray(s.score_fn(m), jnp.float32) for spec in self.specs],
-                              machine)
+        return self._per_game("score_fn", jnp.float32, 0, machine, game)
 
     def _terminated(self, machine: MachineState, game) -> jax.Array:
-        return jax.lax.switch(game, [lambda m, s=spec: jnp.asarray(s.terminated_fn(m), jnp.bool_)
-                                     for spec in self.specs], machine)
+        return self._per_game("terminated_fn", jnp.bool_, False, machine, game)
 
     def _lives(self, machine: MachineState, game) -> jax.Array:
-        def lives(spec):
-            if spec.lives_fn is None:
-                return lambda m: jnp.int32(-1)
-            return lambda m: jnp.asarray(spec.lives_fn(m), jnp.int32)
-        return jax.lax.switch(game, [lives(spec) for spec in self.specs], machine)
+        return self._per_game("lives_fn", jnp.int32, -1, machine, game)
+
+    def _per_game(self, field: str, dtype, default, machine: MachineState, game) -> jax.Array:
+        """The game's `field` function (its score, end or lives) of `machine`: a `lax.switch`
+        over the mix's distinct functions, each game mapped to its own by a table. Games that
+        share a function (the variants of a generated family: one score function, the ROM is
+        data) share a branch, so the program does not grow with the number of games; a game
+        without the function (no lives) reads `default`."""
+        functions, branch_of = self._distinct_functions(field)
+        branches = [(lambda m: jnp.asarray(default, dtype)) if fn is None else
+                    (lambda m, fn=fn: jnp.asarray(fn(m), dtype)) for fn in functions]
+        return jax.lax.switch(jnp.asarray(branch_of)[game], branches, machine)
+
+    def _distinct_functions(self, field: str) -> tuple[list, np.ndarray]:
+        """The distinct `field` functions of the specs, in first-seen order, and each game's index into them."""
+        functions: list = []
+        branch_of = []
+        for spec in self.specs:
+            fn = getattr(spec, field)
+            index = next((i for i, known in enumerate(functions) if known is fn), None)
+            if index is None:
+                index = len(functions)
+                functions.append(fn)
+            branch_of.append(index)
+        return functions, np.array(branch_of, np.int32)
 
     def _max_episode_steps(self, params: EnvParams, game) -> jax.Array:
         return params.max_episode_steps[game]

@@ -136,6 +136,44 @@ def test_a_users_game_spec_mixes_with_registered_ones(counter_rom):
     assert float(reward) == float(single_reward) == 4.0
 
 
+def _switch_sizes(env, params) -> list[int]:
+    """The number of branches of every `lax.switch`/`cond` in the traced step of `env`."""
+    _, state = env.reset(jax.random.key(0), params, game=0)
+    jaxpr = jax.make_jaxpr(lambda k, s: env.step(k, s, 1, params))(jax.random.key(1), state)
+    sizes = []
+
+    def walk(jaxpr):
+        for eqn in jaxpr.eqns:
+            if eqn.primitive.name == "cond":
+                sizes.append(len(eqn.params["branches"]))
+            for value in eqn.params.values():
+                for item in value if isinstance(value, (tuple, list)) else (value,):
+                    inner = getattr(item, "jaxpr", None)
+                    if inner is not None:
+                        walk(inner if hasattr(inner, "eqns") else inner.jaxpr)
+    walk(jaxpr.jaxpr)
+    return sizes
+
+
+def test_games_that_share_their_functions_share_one_branch(counter_rom):
+    """A generated family's variants share their score, end and lives functions (the ROM is data):
+    the step switches over the distinct functions, so it does not grow with the number of games."""
+    import dataclasses
+
+    copies = [dataclasses.replace(COUNTER, id=f"Counter{i}") for i in range(3)]
+    shared, shared_params = octax_core.make_mix(copies, roms=[counter_rom] * 3)
+    assert 3 not in _switch_sizes(shared, shared_params)
+    own_score = dataclasses.replace(copies[2], score_fn=lambda m: m.V[0].astype(jnp.int32) * 2)
+    distinct, distinct_params = octax_core.make_mix([*copies[:2], own_score], roms=[counter_rom] * 3)
+    # one more two-way switch than the shared mix has: the score's, over two distinct functions
+    assert _switch_sizes(distinct, distinct_params).count(2) == _switch_sizes(shared, shared_params).count(2) + 1
+    _, state = distinct.reset(jax.random.key(0), distinct_params, game=2)
+    _, _, reward, *_ = distinct.step(jax.random.key(0), state, 1, distinct_params)
+    _, state = distinct.reset(jax.random.key(0), distinct_params, game=0)
+    _, _, reward0, *_ = distinct.step(jax.random.key(0), state, 1, distinct_params)
+    assert float(reward) == 2 * float(reward0) == 8.0  # each game still reads its own function
+
+
 def test_a_machine_of_profiles_needs_its_profile():
     machine = octax_core.Machine("chip8", profiles=(("chip8", 11), ("schip", 15)))
     assert machine.instructions_per_frame == 15 and machine.quirks == octax_core.QUIRK_PROFILES["chip8"]
