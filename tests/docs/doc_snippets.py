@@ -294,6 +294,13 @@ def _serve() -> int:
             os.environ.update(request["env"])
             sys.argv = [str(Path(__file__).resolve()), str(plan)]
             sys.stdin = open(os.devnull)
+            if os.environ.get("OCTAX_COMPILE_LOG"):  # tests/compile_log.py: this page's compiles, by page
+                sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+                from compile_log import record_compiles
+
+                page = json.loads(plan.read_text(encoding="utf-8"))[0]["page"]
+                os.environ["PYTEST_CURRENT_TEST"] = f"tests/docs/test_snippets.py::{page}"
+                record_compiles(os.environ["OCTAX_COMPILE_LOG"])
             _exit_as_python_would(_run_blocks(plan))
         deadline, timed_out = time.monotonic() + request["timeout"], False
         while True:
