@@ -1,4 +1,4 @@
-"""Scratch: `octax-gym train` with the torso's input layout as the octax paper's code has it.
+"""The conv torso in the input layout of the octax paper's code, for an A/B run of `octax-gym train`.
 
 The paper's PPO (octax/agents/ppo.py + wrappers.py at riiswa/octax f1cb740) gives flax nn.Conv the
 gymnax observation (B, 4, 32, 64) as NHWC: height = the 4 frames, width = the 32 rows, channels =
