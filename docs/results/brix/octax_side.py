@@ -10,7 +10,7 @@ warnings.filterwarnings("ignore")
 import jax, jax.numpy as jnp, numpy as np
 OUT = os.environ.get("OUT", ".")  # where the JSON summary goes
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from policies import POLICIES, summarize
+from policies import POLICIES, run_requests, summarize
 from octax.env import OctaxEnv
 from octax.environments import brix as game
 
@@ -43,13 +43,7 @@ if __name__ == "__main__":
                     "lit_pixels": int(s0.display.sum()), "instructions_per_step": env.instructions_per_step * env.frame_skip,
                     "max_steps": env.max_num_steps_per_episodes, "obs_shape": list(env.pad_frame(s0.display).shape)}
     print(json.dumps(out["start"]), flush=True)
-    res = []
-    for name, T, n in [(a.split(":")[0], int(a.split(":")[1]), int(a.split(":")[2])) for a in sys.argv[1:] if ":" in a]:
-        t0 = time.time()
-        r, d, lives, acts = rollout(POLICIES[name], n, T, 0)
-        s = summarize(name, r, d, T); s["seconds"] = round(time.time() - t0, 1)
-        s["first_actions_ep0"] = acts[:8, 0].tolist()
-        res.append(s); print(json.dumps(s), flush=True)
+    res = run_requests(rollout, sys.argv[1:], first_actions=True)
     out["results"] = res
     tag = "five" if five_balls else "paper"
     json.dump(out, open(f"{OUT}/octax_{tag}.json", "w"), indent=1)

@@ -11,7 +11,7 @@ os.environ.setdefault("OCTAX_ROM_DIR", "/work/shared/roms/octax")
 import jax, jax.numpy as jnp, numpy as np
 OUT = os.environ.get("OUT", ".")  # where the JSON summary goes
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from policies import POLICIES, summarize
+from policies import POLICIES, run_requests, summarize
 import octax_core
 
 five = "--five" in sys.argv
@@ -52,12 +52,7 @@ if __name__ == "__main__":
     out["start"] = {"pc": hex(int(m.pc)), "V": [int(v) for v in m.V], "delay": int(m.delay_timer),
                     "max_steps": int(params.max_episode_steps), "obs_shape": list(_.shape)}
     print(json.dumps(out["start"]), flush=True)
-    res = []
-    for name, T, n in [(a.split(":")[0], int(a.split(":")[1]), int(a.split(":")[2])) for a in sys.argv[1:] if ":" in a]:
-        t0 = time.time()
-        r, d, lives, acts = rollout(POLICIES[name], n, T, 0)
-        s = summarize(name, r, d, T); s["seconds"] = round(time.time() - t0, 1)
-        res.append(s); print(json.dumps(s), flush=True)
+    res = run_requests(rollout, sys.argv[1:])
     out["results"] = res
     tag = ("five" if five else "paper") + ("_frozen" if frozen else "") + ("_noop30" if noop30 else "") + ("_octaxpace" if octaxpace else "")
     json.dump(out, open(f"{OUT}/ours_{tag}.json", "w"), indent=1)

@@ -49,3 +49,18 @@ def follow2(V, key):
     return jnp.where((d < 1) & (pad >= 2), 1, jnp.where((d > 4) & (pad <= 56), 2, 0)).astype(jnp.int32)
 
 POLICIES["follow2"] = follow2
+
+
+def run_requests(rollout, argv, first_actions=False):
+    """Each `name:steps:episodes` argument of `argv`: `rollout(policy, episodes, steps, seed 0)`
+    summarized and printed as one JSON line; returns the summaries."""
+    import json, time
+    results = []
+    for name, T, n in [(a.split(":")[0], int(a.split(":")[1]), int(a.split(":")[2])) for a in argv if ":" in a]:
+        t0 = time.time()
+        r, d, lives, acts = rollout(POLICIES[name], n, T, 0)
+        s = summarize(name, r, d, T); s["seconds"] = round(time.time() - t0, 1)
+        if first_actions:
+            s["first_actions_ep0"] = acts[:8, 0].tolist()
+        results.append(s); print(json.dumps(s), flush=True)
+    return results
