@@ -29,10 +29,22 @@ def tiny(**overrides):
     return preset("cpu", "selfplay", games=(TWO_COUNTERS,), **{**TINY, **overrides})
 
 
+# The checks share their programs (compiling them is what this module pays for): one run with a pool
+# and its same-seed repeat (`runs`), one pool trainer's first rollout (`pooled`).
+POOLED = dict(pool=2, pool_prob=1.0)
+
+
 @pytest.fixture(scope="module")
-def run(two_counters_rom, tmp_path_factory):
-    out = tmp_path_factory.mktemp("selfplay") / "run"
-    return train(tiny(save_at_evals=True), out, roms=[two_counters_rom], progress=False)
+def runs(two_counters_rom, tmp_path_factory):
+    """A TINY run with a pool of past selves, and the same run again (the same seed), each in its folder."""
+    config = tiny(save_at_evals=True, pool=2)
+    return [train(config, tmp_path_factory.mktemp("selfplay") / "run", roms=[two_counters_rom], progress=False)
+            for _ in range(2)]
+
+
+@pytest.fixture(scope="module")
+def run(runs):
+    return runs[0]
 
 
 def test_a_row_per_evaluation_with_the_matches_columns(run):
@@ -61,25 +73,36 @@ def test_params_change_and_agents_are_saved_as_the_loop_saves_them(run):
     assert agent(np.zeros((5, 32, 64), np.uint8)) in (0, 1, 2)
 
 
-def test_the_same_seed_gives_the_same_run(run, two_counters_rom, tmp_path):
-    again = train(tiny(save_at_evals=True), tmp_path, roms=[two_counters_rom], progress=False)
+def test_the_same_seed_gives_the_same_run(runs):
     timing = ("wall_s", "env_steps_per_s")
-    assert [{k: v for k, v in r.items() if k not in timing} for r in again["rows"]] == \
-           [{k: v for k, v in r.items() if k not in timing} for r in run["rows"]]
-    for a, b in zip(jax.tree.leaves(again["final_params"]), jax.tree.leaves(run["final_params"])):
+    first, again = ([{k: v for k, v in r.items() if k not in timing} for r in run["rows"]] for run in runs)
+    assert again == first
+    for a, b in zip(jax.tree.leaves(runs[1]["final_params"]), jax.tree.leaves(runs[0]["final_params"])):
         np.testing.assert_array_equal(a, b)
 
 
 def _collect(config, game, rom):
+    """The lanes, the trainer, its first runner and its first rollout's (runner, batch, totals), in one program."""
     lanes = SeatLanes((game,), dict(config.env_overrides), roms=[rom])
     trainer = make_trainer(config, lanes)
-    runner = jax.jit(trainer.init)(jax.random.key(0), jnp.int32(0))
-    return lanes, trainer, runner, jax.jit(trainer.collect)(runner)
+
+    @jax.jit
+    def first(key):
+        runner = trainer.init(key, jnp.int32(0))
+        return runner, trainer.collect(runner)
+
+    return (lanes, trainer, *first(jax.random.key(0)))
 
 
-def test_a_past_self_plays_one_seat_of_an_env_and_its_samples_weigh_zero(two_counters_rom):
-    config = tiny(pool=2, pool_prob=1.0)
-    _, trainer, _, (after, batch, _) = _collect(config, TWO_COUNTERS, two_counters_rom)
+@pytest.fixture(scope="module")
+def pooled(two_counters_rom):
+    """A pool trainer (2 past selves, one on a seat of every env), its first runner and its first rollout."""
+    config = tiny(**POOLED)
+    return (config, *_collect(config, TWO_COUNTERS, two_counters_rom))
+
+
+def test_a_past_self_plays_one_seat_of_an_env_and_its_samples_weigh_zero(pooled):
+    config, _, trainer, _, (after, batch, _) = pooled
     weight = np.asarray(batch[-1]).reshape(config.num_steps, config.num_envs, 2)
     # every env (pool_prob 1): one seat, the same for the whole rollout, played by the past self
     assert (weight.sum(-1) == 1).all() and (weight == weight[:1]).all()
@@ -99,27 +122,23 @@ def test_a_past_self_plays_one_seat_of_an_env_and_its_samples_weigh_zero(two_cou
         logits, value = trainer.network.apply(params, obs)
         return masked(logits, legal), value
 
-    def grad(minibatch):
-        return jax.grad(lambda p: ppo_loss(p, apply, config, minibatch)[0])(after.params)
-
-    for a, b in zip(jax.tree.leaves(grad(tuple(flat))), jax.tree.leaves(grad(tuple(changed)))):
+    grad = jax.jit(jax.grad(lambda p, minibatch: ppo_loss(p, apply, config, minibatch)[0]))
+    for a, b in zip(jax.tree.leaves(grad(after.params, tuple(flat))),
+                    jax.tree.leaves(grad(after.params, tuple(changed)))):
         np.testing.assert_allclose(a, b, rtol=1e-5, atol=1e-7)
 
 
-def test_the_pool_takes_a_snapshot_at_each_evaluations_update(two_counters_rom):
-    config = tiny(pool=2, pool_prob=1.0)
-    lanes = SeatLanes((TWO_COUNTERS,), dict(config.env_overrides), roms=[two_counters_rom])
-    trainer = make_trainer(config, lanes)
-    runner = jax.jit(trainer.init)(jax.random.key(0), jnp.int32(0))
+def test_the_pool_takes_a_snapshot_at_each_evaluations_update(pooled):
+    config, _, _, start, _ = pooled
     draw = jax.jit(lambda r: selfplay.draw_opponent(config, r)[0])
-    counts = []
+    runner, counts = start, []
     for update in range(5):  # eval_interval = 2 updates: snapshots at updates 0, 2, 4 into a ring of 2
         runner = draw(runner._replace(updates=jnp.int32(update),
                                       params=jax.tree.map(lambda x: x + update, runner.params)))
         counts.append(int(runner.pool.count))
     assert counts == [1, 1, 2, 2, 2]
     leaf = lambda tree: np.asarray(jax.tree.leaves(tree)[0])  # noqa: E731
-    base = leaf(jax.jit(trainer.init)(jax.random.key(0), jnp.int32(0)).params)
+    base = leaf(start.params)
     # slot 0 holds update 4's params (base + 0+1+2+3+4), slot 1 update 2's (base + 0+1+2)
     np.testing.assert_allclose(leaf(runner.pool.params)[0], base + 10, rtol=1e-6)
     np.testing.assert_allclose(leaf(runner.pool.params)[1], base + 3, rtol=1e-6)
