@@ -15,7 +15,7 @@ from typing import Any, Callable
 import jax
 import jax.numpy as jnp
 
-from octax_core.env.games import GameSpec
+from octax_core.env.games import GameSpec, get_spec, list_games
 from octax_core.validate import check_bool, check_choice, check_int, check_probability
 
 OBS_SCALES = (1, 255)
@@ -44,6 +44,11 @@ class EnvConfig:
         skip_idle: fast-forward the rest of a frame once the program provably spins, and give
             each env of a batch its own frame clock (`octax_core.emulator.idle`): the same
             observations, rewards and flags, bit for bit, at a cost that follows the work.
+        mirror: two-player envs (`make_multi`) of a game whose sides mirror each other
+            (`Seats.mirror`): seat 1 sees the screen flipped across the game's axis and its
+            actions are mapped through `Seats.mirror_actions`, so one network plays both seats
+            from the same side; scores and rewards are untouched. `make_multi` refuses it for
+            other games, the one-player envs always.
     """
 
     frames_per_step: int = _option(4, check_int)
@@ -53,6 +58,7 @@ class EnvConfig:
     noop_max: int = _option(0, functools.partial(check_int, minimum=0))
     autoreset: bool = _option(False, check_bool)
     skip_idle: bool = _option(True, check_bool)
+    mirror: bool = _option(False, check_bool)
 
 
 @jax.tree_util.register_dataclass
@@ -99,7 +105,16 @@ def make_config(spec: GameSpec, **options: Any) -> tuple[EnvConfig, EnvParams]:
     if spec.instructions_per_frame is not None:
         defaults["instructions_per_frame"] = spec.instructions_per_frame
     values = {**defaults, **given}
-    return _build(EnvConfig, values), _build(EnvParams, values)
+    config = _build(EnvConfig, values)
+    if config.mirror and (spec.seats is None or spec.seats.mirror is None):
+        raise ValueError(f"{spec.id} has no mirrored seats (Seats.mirror): mirror=True is for "
+                         f"{', '.join(mirrored_games())}")
+    return config, _build(EnvParams, values)
+
+
+def mirrored_games() -> list[str]:
+    """The two-player games whose seats mirror each other (`Seats.mirror`): those `mirror=True` takes."""
+    return [game for game in list_games(players=2) if get_spec(game).seats.mirror is not None]
 
 
 def make_params(spec: GameSpec, **options: Any) -> EnvParams:

@@ -70,6 +70,9 @@ class Env:
     def __init__(self, spec: GameSpec, config: EnvConfig, rom_path=None):
         from octax_core.env.romstore import load_game_rom  # the store does file I/O: only at make
 
+        if config.mirror:  # MultiEnv takes it (make_multi); a one-player env has no second seat
+            raise ValueError(f"mirror=True is an option of the two-player env: octax_core.make_multi({spec.id!r}, "
+                             "mirror=True)")
         self.spec, self.config = spec, config
         self.machine = Machine(spec.platform, quirks=spec.quirks, instructions_per_frame=config.instructions_per_frame,
                                skip_idle=config.skip_idle)

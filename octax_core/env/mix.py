@@ -67,6 +67,8 @@ class MixEnv(Env):
         self.spec = self.specs[0]
         self.weights = _check_weights(weights, len(self.specs))
         configs, params = zip(*(make_config(spec, **options) for spec in self.specs))
+        if configs[0].mirror:
+            raise ValueError("mirror=True is an option of the two-player env (octax_core.make_multi); a mix is one-player")
         self.configs = configs
         platform = self.specs[0].platform
         self.machine = Machine(platform, skip_idle=configs[0].skip_idle,

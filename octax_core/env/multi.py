@@ -23,6 +23,12 @@ pieces that differ for two seats replaced:
   the functional core, an action the mask closes is played as no-op (under `jit` nothing can be
   raised); the Gymnasium and PettingZoo layers raise an error for it instead. Simultaneous games
   have `current_player` -1 and every action open to both seats.
+- `mirror=True` (games with `Seats.mirror`: `octax_core.env.config.mirrored_games()`): seat 1
+  sees the screens flipped across the game's axis (its player plane as before) and plays its
+  actions through `Seats.mirror_actions`, both in its observation and in its legal mask, so
+  one network plays either seat as seat 0 and still knows which by the plane. The machine,
+  `last_action` (sticky actions) and the scores stay the game's own. A scripted player
+  (`Seats.scripted_policy`) gives the game's own action: map seat 1's with `mirror_action`.
 
 Everything is for one env: batch with `jax.vmap` (`in_axes=(0, 0, 0, None)`), as for `Env`.
 """
@@ -53,10 +59,15 @@ class MultiEnv(Env):
             raise ValueError(f"{spec.id} is a one-player game; two-player games: {', '.join(list_games(players=2))}")
         self.seats = spec.seats
         startup = spec.startup if spec.seats.startup is None else spec.seats.startup
-        super().__init__(dataclasses.replace(spec, startup=startup), config, rom_path)
-        self.spec = spec
+        # the one-player Env refuses mirror (it has no second seat); this env applies it in _observe
+        super().__init__(dataclasses.replace(spec, startup=startup), dataclasses.replace(config, mirror=False),
+                         rom_path)
+        self.spec, self.config = spec, config
         self._seat_masks = np.array([[0] + [1 << k for k in keys] for keys in spec.seats.action_keys], np.uint32)
         self._action_masks = self._seat_masks[0]  # num_actions: every seat has as many
+        # per seat, the game's action for each action the seat plays (identity without mirror)
+        mirrored = spec.seats.mirror_actions if config.mirror else None
+        self._seat_actions = np.array([range(self.num_actions), mirrored or range(self.num_actions)], np.int32)
 
     @property
     def players(self) -> int:
@@ -72,6 +83,16 @@ class MultiEnv(Env):
         return self.seats.turn_based
 
     @property
+    def mirrored(self) -> bool:
+        """Seat 1 sees and plays the mirror image (`mirror=True`)."""
+        return self.config.mirror
+
+    def mirror_action(self, actions) -> jax.Array:
+        """(players,) actions as the seats play them -> the game's own, or back (an involution):
+        seat 1's mapped through `Seats.mirror_actions` when `mirrored`, else unchanged."""
+        return jnp.asarray(self._seat_actions)[jnp.arange(self.players), actions]
+
+    @property
     def observation_shape(self) -> tuple[int, int, int]:
         """One seat's observation: the step's screens, then the player plane."""
         frames, height, width = super().observation_shape
@@ -83,6 +104,8 @@ class MultiEnv(Env):
         """`Env.step_env` with one action per seat; a closed action (see `legal_action_mask`) is no-op."""
         actions = self._check_action(actions)
         actions = jnp.where(self.legal_action_mask(state)[jnp.arange(self.players), actions], actions, 0)
+        if self.mirrored:
+            actions = self.mirror_action(actions)
         return self._transition(key, state, actions, params)
 
     def current_player(self, state: EnvState) -> jax.Array:
@@ -101,7 +124,10 @@ class MultiEnv(Env):
             open_to_mover = jnp.asarray(self.seats.legal_fn(state.machine), jnp.bool_).at[0].set(True)
         only_noop = jnp.arange(self.num_actions) == 0
         mover = self.current_player(state)
-        return jnp.where((jnp.arange(self.players) == mover)[:, None], open_to_mover[None], only_noop[None])
+        masks = jnp.where((jnp.arange(self.players) == mover)[:, None], open_to_mover[None], only_noop[None])
+        if self.mirrored:  # a seat's action a is the game's _seat_actions[seat, a]
+            masks = jnp.take_along_axis(masks, jnp.asarray(self._seat_actions), axis=1)
+        return masks
 
     def info(self, state: EnvState) -> dict[str, jax.Array]:
         """`Env.info` (score per seat) plus `current_player` and `legal_action_mask`."""
@@ -123,7 +149,11 @@ class MultiEnv(Env):
         frames = super()._observe(screens)
         plane = jnp.arange(self.players, dtype=frames.dtype) * jnp.asarray(self.config.obs_scale, frames.dtype)
         planes = jnp.broadcast_to(plane[:, None, None, None], (self.players, 1, *frames.shape[1:]))
-        return jnp.concatenate([jnp.broadcast_to(frames[None], (self.players, *frames.shape)), planes], axis=1)
+        if self.mirrored:  # seat 1 sees the screens flipped across the game's axis
+            seen = jnp.stack([frames, jnp.flip(frames, axis=_MIRROR_AXIS[self.seats.mirror])])
+        else:
+            seen = jnp.broadcast_to(frames[None], (self.players, *frames.shape))
+        return jnp.concatenate([seen, planes], axis=1)
 
     def _score(self, machine: MachineState, game) -> jax.Array:
         scores = jnp.asarray(self.seats.score_fn(machine), jnp.float32)
@@ -132,14 +162,19 @@ class MultiEnv(Env):
         return scores
 
 
+_MIRROR_AXIS = {"left-right": -1, "top-bottom": -2}  # `Seats.mirror` -> the frames' axis it flips (W, H)
+
+
 def make_multi(game: Union[str, GameSpec], *, rom=None, **options: Any) -> tuple[MultiEnv, EnvParams]:
     """Builds the two-player env of a game in `list_games(players=2)` (or your `GameSpec` with seats).
 
-    Takes the same options as `octax_core.make` (`ENV_OPTIONS`).
+    Takes the same options as `octax_core.make` (`ENV_OPTIONS`), and `mirror` (see the module
+    docstring) for the games `octax_core.env.config.mirrored_games()` lists.
 
     Raises:
         KeyError: unknown game id. ValueError: a one-player game (the message lists the two-player
-        ones) or an option out of range. TypeError: an unknown option.
+        ones), `mirror=True` for a game without mirrored seats (the message lists those with),
+        or an option out of range. TypeError: an unknown option.
     """
     spec = game if isinstance(game, GameSpec) else get_spec(game)
     config, params = make_config(spec, **options)

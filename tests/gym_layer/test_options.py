@@ -47,7 +47,8 @@ def test_the_options_are_the_dataclass_fields():
 @pytest.mark.parametrize("name", GYM_OPTIONS)
 def test_each_option_reaches_the_core_env(name, counter_rom):
     value = _other_value(FIELDS[name])
-    for env in (OctaxVectorEnv(COUNTER, 2, rom=counter_rom, **{name: value}),
-                OctaxEnv(COUNTER, rom=counter_rom, **{name: value})._vector):
+    # mirror is a two-player env's option (games with mirrored seats): one seat against an opponent
+    game, where = ("Cycles", {"opponent": "noop"}) if name == "mirror" else (COUNTER, {"rom": counter_rom})
+    for env in (OctaxVectorEnv(game, 2, **where, **{name: value}), OctaxEnv(game, **where, **{name: value})._vector):
         held = getattr(env.core_env.config, name) if name in EnvConfig.__dataclass_fields__ else getattr(env.params, name)
         assert (held.item() if hasattr(held, "item") else held) == pytest.approx(value)

@@ -120,6 +120,8 @@ SEATS = Seats(
     zero_sum=True,
     names=("left cycle", "right cycle"),
     scripted_policy=scripted_policy,
+    mirror="left-right",  # measured: docs/multiplayer.md, "Mirrored seats"
+    mirror_actions=(0, 1, 2, 4, 3),  # up and down stay, left and right swap
 )
 
 

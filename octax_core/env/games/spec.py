@@ -20,6 +20,9 @@ from octax_core.emulator.state import MEMORY_OFFSET, MachineState
 StateFn = Callable[[MachineState], jax.Array]
 
 
+MIRROR_AXES = ("left-right", "top-bottom")  # `Seats.mirror`: the screen flipped across its columns, or its rows
+
+
 @dataclasses.dataclass(frozen=True)
 class Seats:
     """How two players share one machine: each seat's keys, each seat's score, whose turn it is.
@@ -46,6 +49,14 @@ class Seats:
             that reads the machine (registers, RAM) as a bot would, pure JAX so that it runs
             batched inside a jitted rollout (`seat` is a Python int); the opponent self-play is
             evaluated against. None where the game has none.
+        mirror: the axis across which the two sides are each other's mirror image, "left-right"
+            or "top-bottom" (`MIRROR_AXES`), for a game whose rules treat the seats alike; None
+            (the default) where they differ. Declared only where measured: `make_multi(...,
+            mirror=True)` then shows seat 1 the flipped screen, so one network sees both seats
+            from seat 0's side (docs/multiplayer.md, "Mirrored seats").
+        mirror_actions: with `mirror`, the action seat 1 plays in the mirrored view for each of
+            its actions: a permutation of 0..num_actions-1 that keeps no-op (0) and is its own
+            inverse (left and right keys swapped). Required with `mirror`, refused without it.
     """
 
     action_keys: tuple[tuple[int, ...], ...]
@@ -56,6 +67,8 @@ class Seats:
     startup: Optional[tuple[tuple[int, int], ...]] = None
     names: tuple[str, ...] = ("player 1", "player 2")
     scripted_policy: Optional[Callable[[MachineState, int], jax.Array]] = None
+    mirror: Optional[str] = None
+    mirror_actions: Optional[tuple[int, ...]] = None
 
     def __post_init__(self):
         if len(self.action_keys) != 2:
@@ -68,6 +81,18 @@ class Seats:
                 raise ValueError(f"Seats: a seat's keys are distinct CHIP-8 keys 0..15, got {keys}")
         if len(self.names) != len(self.action_keys):
             raise ValueError(f"Seats: one name per seat, got {self.names}")
+        if self.mirror is not None and self.mirror not in MIRROR_AXES:
+            raise ValueError(f"Seats: unknown mirror axis {self.mirror!r}; valid: {', '.join(MIRROR_AXES)}")
+        if (self.mirror is None) != (self.mirror_actions is None):
+            raise ValueError("Seats: mirror and mirror_actions go together (both or neither), got "
+                             f"mirror={self.mirror!r}, mirror_actions={self.mirror_actions}")
+        if self.mirror_actions is not None:
+            count = len(self.action_keys[0]) + 1
+            permutation = tuple(self.mirror_actions)
+            if (sorted(permutation) != list(range(count)) or permutation[0] != 0
+                    or any(permutation[permutation[a]] != a for a in range(count))):
+                raise ValueError(f"Seats: mirror_actions must be a permutation of 0..{count - 1} that keeps 0 and "
+                                 f"is its own inverse, got {self.mirror_actions}")
 
     @property
     def players(self) -> int:
