@@ -6,6 +6,7 @@
     octax-gym train ppo --resume runs/ppo                                           # a run cut short, continued
     octax-gym train ppo --devices all --coordinator node0:29500 --num-processes 2 --process-id $RANK
     octax-gym train multitask --games Airplane,Brix,Deep8,Filter --num-envs 64       # one agent for all four
+    octax-gym train multitask --games archive:gen/dodger:train --eval-games archive:gen/dodger:test --no-game-input
     octax-gym train selfplay --game Cycles --pool 4                                  # both seats, past selves
     octax-gym train bc --dataset octax/Flak/expert-v0 --num-seeds 2                  # offline, on a dataset
 
@@ -83,7 +84,12 @@ def add_commands(commands: argparse._SubParsersAction) -> None:
     train.add_argument("algorithm", choices=ALGORITHMS, metavar="ALGO",
                        help="ppo, pqn, multitask, selfplay (a two-player game), or bc and cql (offline, on --dataset)")
     train.add_argument("--games", "--game", dest="games", metavar="G[,G...]",
-                       help="game ids, comma-separated, or octax16 (the paper's 16); default Brix")
+                       help="game ids, comma-separated, octax16 (the paper's 16), or archive:DIR[:train|test] (an "
+                            "octax-gym generate archive's accepted games); default Brix")
+    train.add_argument("--eval-games", default=None, metavar="G[,G...]",
+                       help="ppo (one game), pqn (one game), multitask: games every agent is evaluated on too but "
+                            "never trains on, as --games (e.g. archive:DIR:test, the held-out variants); their "
+                            "progress.csv rows have split 'eval'")
     train.add_argument("--preset", default="cpu", metavar="NAME",
                        help="starting settings: cpu (64 envs, 655,360 steps; the default) or paper (512 envs x 32 "
                             "steps, 4 x 32 minibatches, Adam 5e-4, 5M steps an agent)")
@@ -139,6 +145,8 @@ def config_from_args(args: argparse.Namespace):
         raise ValueError(f"{flags}: not a setting of {args.algorithm} (of {' and '.join(owners)})")
     if args.games is not None:
         given["games"] = resolve_games(args.games)
+    if args.eval_games is not None:
+        given["eval_games"] = resolve_games(args.eval_games)
     if args.algorithm in ("bc", "cql") and given.get("dataset"):  # the dataset's game and env options
         from octax_gym.train.offline import dataset_env
 
@@ -182,7 +190,8 @@ def _cmd_train(args: argparse.Namespace) -> int:
 
 def _resumed(args: argparse.Namespace):
     """The config of the run in `--resume OUT` (its config.json); refuses other settings."""
-    defaults = {"games": None, "preset": "cpu", "devices": None, "agent_map": None, "out_dir": None, "anneal_lr": None,
+    defaults = {"games": None, "eval_games": None, "preset": "cpu", "devices": None, "agent_map": None,
+                "out_dir": None, "anneal_lr": None,
                 "clip_value_loss": None, "game_input": None, "save_at_evals": None,
                 **{n: None for n in (*SETTINGS, *ENV_FLAGS)}}
     if given := [name for name, default in defaults.items() if getattr(args, name) != default]:
@@ -200,6 +209,7 @@ def _resumed(args: argparse.Namespace):
     fields = {field.name for field in dataclasses.fields(TrainConfig)}
     values = {k: v for k, v in saved.items() if k in fields}
     values["games"] = tuple(values["games"])
+    values["eval_games"] = tuple(values.get("eval_games", ()))
     values["env_overrides"] = tuple(tuple(pair) for pair in values.get("env_overrides", ()))
     if values["algorithm"] != args.algorithm:
         raise ValueError(f"--resume: {args.resume} is a {values['algorithm']} run, not {args.algorithm}")

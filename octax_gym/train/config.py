@@ -18,6 +18,7 @@ ALGORITHMS = ("ppo", "pqn", "multitask", "selfplay", "bc", "cql")  # multitask: 
 # the games; selfplay: one PPO agent per seed on both seats of a two-player game (seats.py, selfplay.py)
 OFFLINE = ("bc", "cql")  # trained on a Minari dataset instead of a rollout (offline.py)
 DEVICES = ("", "all")
+ARCHIVE = "archive:"  # in games: archive:DIR[:SPLIT|:NAME], an `octax-gym generate` archive's games
 AGENT_MAPS = ("auto", "vmap", "map")
 ENV_FLAGS = {"max_episode_steps": int, "frames_per_step": int, "repeat_action_probability": float,
              "noop_max": int}  # octax_core.make options a run may override (for every game alike)
@@ -53,6 +54,7 @@ class TrainConfig:
     devices: str = ""  # "": one device; "all": every agent's envs split over every device
     agent_map: str = "auto"  # how agents share the program: vmap, map (one after another), auto (many.py)
     env_overrides: tuple = ()  # ((name, value), ...) of ENV_FLAGS, for every game
+    eval_games: tuple = ()  # games every agent is evaluated on too but never trains on (held-out variants)
     # PPO's
     gae_lambda: float = 0.95
     clip_eps: float = 0.2
@@ -99,6 +101,10 @@ class TrainConfig:
         return [game.id if isinstance(game, GameSpec) else game for game in self.games]
 
     @property
+    def eval_game_ids(self) -> list[str]:
+        return [game.id if isinstance(game, GameSpec) else game for game in self.eval_games]
+
+    @property
     def multitask(self) -> bool:
         return self.algorithm == "multitask"
 
@@ -108,23 +114,30 @@ class TrainConfig:
 
     @property
     def agents(self) -> list[tuple[str, int]]:
-        """(game, seed) of each row of the log (an evaluation of one game by one agent), game-major.
-        One agent per row, except in a multi-task run, where the agent of a seed plays every game."""
-        return [(game, seed) for game in self.game_ids for seed in self.seeds]
+        """(game, seed) of each row of the log (an evaluation of one game by one agent), game-major,
+        the `eval_games` after the trained games. One agent per row, except in a multi-task run,
+        where the agent of a seed plays every game, and in a run with `eval_games`, where it plays those too."""
+        return [(game, seed) for game in self.game_ids + self.eval_game_ids for seed in self.seeds]
 
     @property
     def agent_names(self) -> list[str]:
         """The trained agents, in the order of the agent axis: `<game>-seed<s>`, or `multitask-seed<s>`."""
         if self.multitask:
             return [f"multitask-seed{seed}" for seed in self.seeds]
-        return [f"{game}-seed{seed}" for game, seed in self.agents]
+        return [f"{game}-seed{seed}" for game in self.game_ids for seed in self.seeds]
 
     @property
     def row_agents(self) -> list[int]:
         """For each row of `agents`, the index of the agent that plays it."""
-        if self.multitask:
-            return [i for _ in self.game_ids for i in range(self.num_seeds)]
+        if self.multitask or self.eval_games:  # with eval_games a ppo or pqn run trains one game (check)
+            return [i for _ in self.agents[::self.num_seeds] for i in range(self.num_seeds)]
         return list(range(len(self.agents)))
+
+    @property
+    def row_splits(self) -> list[str]:
+        """For each row of `agents`: "train" (a game the agent trains on) or "eval" (one of `eval_games`)."""
+        trained = len(self.game_ids) * self.num_seeds
+        return ["train" if i < trained else "eval" for i in range(len(self.agents))]
 
     def learning_rate_at(self, update: int) -> float:
         """Adam's rate during update `update` (from 0): constant, or decaying linearly to 0 with `anneal_lr`."""
@@ -203,19 +216,40 @@ class TrainConfig:
                                  "from each seat)")
             if self.devices:
                 raise ValueError("devices must be '' for selfplay (its two-seat envs run on one device)")
+        if self.eval_games:
+            self._check_eval_games()
         if self.multitask and self.num_envs % len(self.games):
             raise ValueError(f"multitask: num_envs = {self.num_envs} must be a multiple of the {len(self.games)} "
                              "games (lane i plays game i mod G, so each game gets as many lanes)")
         return self
 
+    def _check_eval_games(self) -> None:
+        if self.algorithm not in ("ppo", "pqn", "multitask"):
+            raise ValueError(f"eval_games is a setting of ppo, pqn and multitask, not of {self.algorithm}")
+        ids = self.eval_game_ids
+        if len(set(ids)) != len(ids):
+            raise ValueError(f"eval_games names a game twice: {', '.join(ids)}")
+        if both := [game for game in ids if game in self.game_ids]:
+            raise ValueError(f"eval_games: {', '.join(both)} also trained on (games); eval_games are games the "
+                             "agents never train on")
+        if not self.multitask and len(self.games) != 1:
+            raise ValueError(f"eval_games: a {self.algorithm} run with eval_games trains one game (its rows are "
+                             f"keyed by game and seed); got games {', '.join(self.game_ids)}: one run per game")
+        if self.multitask and self.game_input:
+            raise ValueError("eval_games: a multitask agent with game_input reads its game's one-hot, which a game "
+                             "it never trained on has none of; give --no-game-input (the screen alone)")
+
 
 def resolve_games(games: Union[str, tuple, list]) -> tuple:
     """Game ids from a comma-separated string or a list; a named mix ("octax16", `octax_core`'s
-    `MIXES`: the paper's 16 games) expands to its games. Gymnasium ids and any-case names are
-    taken (`octax_gym.game_names`).
+    `MIXES`: the paper's 16 games) expands to its games, and `archive:DIR[:SPLIT]` to the GameSpecs of
+    an `octax-gym generate` archive (`octax_gym.generated.load_archive`: its accepted games, of
+    SPLIT "train" or "test", or both; `archive:DIR:NAME`, the one game NAME). Gymnasium ids and
+    any-case names are taken (`octax_gym.game_names`).
 
     Raises:
         UnknownOptionError: a name that is no registered game (the message lists the valid ones).
+        ValueError: an archive that is not there, or an unknown split (`load_archive`'s messages).
     """
     from octax_gym.game_names import resolve_spec
 
@@ -226,9 +260,39 @@ def resolve_games(games: Union[str, tuple, list]) -> tuple:
             out.append(name)
         elif name in MIXES:
             out.extend(MIXES[name])
+        elif name.startswith(ARCHIVE):
+            out.extend(_archive_games(name[len(ARCHIVE):]))
         elif name:
             out.append(resolve_spec(name).id)
     return tuple(out)
+
+
+def _archive_games(text: str) -> list:
+    """`DIR[:SPLIT]` or `DIR:NAME` (one game of the archive)'s GameSpecs; a last part that is
+    neither is part of the folder's path."""
+    from pathlib import Path
+
+    from octax_core.generate.archive import SPLITS
+    from octax_gym.generated import load_archive
+
+    folder, _, part = text.rpartition(":")
+    if part in SPLITS or not text:
+        if not folder:
+            raise _no_folder(text)
+        return load_archive(folder, part)
+    if folder and (Path(folder).expanduser() / "archive.json").is_file():
+        games = load_archive(folder)
+        chosen = [spec for spec in games if spec.id == part]
+        if not chosen:
+            raise ValueError(f"{ARCHIVE}{text}: {part!r} is no split (train, test) and no accepted game of "
+                             f"{folder}; its games: {', '.join(spec.id for spec in games)}")
+        return chosen
+    return load_archive(text)
+
+
+def _no_folder(text: str) -> ValueError:
+    return ValueError(f"{ARCHIVE}{text}: name the archive's folder ({ARCHIVE}DIR, {ARCHIVE}DIR:train, "
+                      f"{ARCHIVE}DIR:test or {ARCHIVE}DIR:NAME, one of its games)")
 
 
 def _choice(name: str, value, choices) -> None:

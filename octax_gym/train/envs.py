@@ -13,7 +13,10 @@ share the mix (tests/train check it). A run of one game is a mix of one: the sam
 
 Why one mix and not an env per game: G games under one `vmap` are one compiled step, where G envs
 would be G programs traced side by side. The evaluation env is a second mix, made without
-autoreset and with `eval_noop_max` no-op starts (evaluate.py says why).
+autoreset and with `eval_noop_max` no-op starts (evaluate.py says why); `eval_games` (games the
+agents are evaluated on but never train on: a generated family's held-out variants) join that mix
+alone, after the run's games, so game g < G is the same game in both mixes and the training mix is
+the one a run without them makes.
 """
 
 from __future__ import annotations
@@ -33,14 +36,19 @@ class Lanes:
     """The training and evaluation mixes of a run's games, and each game's legal actions."""
 
     def __init__(self, games: Sequence, overrides: Optional[dict] = None, eval_noop_max: int = 30,
-                 roms: Optional[Sequence] = None):
+                 roms: Optional[Sequence] = None, eval_games: Sequence = (), eval_roms: Optional[Sequence] = None):
         overrides = dict(overrides or {})
         self.env, self.params = octax_core.make_mix(list(games), roms=roms, autoreset=False, **overrides)
         eval_options = {**overrides, "noop_max": eval_noop_max}
-        self.eval_env, self.eval_params = octax_core.make_mix(list(games), roms=roms, autoreset=False, **eval_options)
-        self.num_actions = np.array([len(spec.action_keys) + 1 for spec in self.env.specs])  # each game's own
+        all_roms = None
+        if roms is not None or eval_roms is not None:
+            all_roms = list(roms or [None] * len(games)) + list(eval_roms or [None] * len(eval_games))
+        self.eval_env, self.eval_params = octax_core.make_mix(list(games) + list(eval_games), roms=all_roms,
+                                                              autoreset=False, **eval_options)
+        # each game's own, the eval_games' after the run's (rows G.. of `legal`: what greedy and sampled index)
+        self.num_actions = np.array([len(spec.action_keys) + 1 for spec in self.eval_env.specs])
         if self.num_actions.max() > ACTIONS:
-            raise ValueError(f"{self.env.games[int(self.num_actions.argmax())]} takes {self.num_actions.max()} "
+            raise ValueError(f"{self.eval_env.games[int(self.num_actions.argmax())]} takes {self.num_actions.max()} "
                              f"actions; the networks have {ACTIONS}")
         self.legal = np.arange(ACTIONS)[None, :] < self.num_actions[:, None]  # (G, ACTIONS) bool
 

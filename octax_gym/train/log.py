@@ -8,6 +8,9 @@ the normalized score from the committed table (`octax_gym.scores`: never re-meas
 training episodes finished since the last evaluation, and the algorithm's metrics averaged over
 those updates. A resumed run rewrites the file with the rows up to its checkpoint.
 
+A run with `eval_games` (games its agents never train on) has a `split` column after `seed`: "train"
+for a row of a game the agent trains on, "eval" for one of those.
+
 A self-play run's evaluation columns are its matches' (selfplay.py's `EVAL_COLUMNS`: win, draw,
 loss and margin against each opponent, greedy and sampled) in place of the one-player ones
 (`EVAL_COLUMNS` here); the other columns are the same.
@@ -63,15 +66,19 @@ class ProgressLog:
 
     def __init__(self, out_dir: Path, agents: Sequence[tuple[str, int]], metric_names: Sequence[str],
                  row_agents: Sequence[int], keep_until: Optional[int] = None, write: bool = True,
-                 eval_columns: Sequence[str] = EVAL_COLUMNS, eval_cells: Callable = evaluation_cells):
+                 eval_columns: Sequence[str] = EVAL_COLUMNS, eval_cells: Callable = evaluation_cells,
+                 splits: Optional[Sequence[str]] = None):
         """A new log of a row per (game, seed) of `agents`, each played by agent `row_agents[i]`
         (training statistics are that agent's); or, with `keep_until` (a resumed run's update),
         the existing rows up to that update, rewritten without the rows a killed run logged after
-        its checkpoint. `eval_cells(evaluation, i, game)` gives row i's `eval_columns`."""
+        its checkpoint. `eval_cells(evaluation, i, game)` gives row i's `eval_columns`; `splits`, each
+        row's split ("train" or "eval"), adds the `split` column."""
         self.csv_path = Path(out_dir) / "progress.csv"
         self.agents, self.metric_names, self.rows, self.write = list(agents), tuple(metric_names), [], write
         self.row_agents, self.eval_cells = list(row_agents), eval_cells
-        self.columns = HEAD_COLUMNS + tuple(eval_columns) + TRAIN_COLUMNS + self.metric_names
+        self.splits = None if splits is None else list(splits)
+        head = HEAD_COLUMNS if splits is None else HEAD_COLUMNS[:2] + ("split",) + HEAD_COLUMNS[2:]
+        self.columns = head + tuple(eval_columns) + TRAIN_COLUMNS + self.metric_names
         if not write:
             return
         if keep_until is not None:
@@ -93,7 +100,8 @@ class ProgressLog:
         for i, (game, seed) in enumerate(self.agents):
             a = self.row_agents[i]
             episodes = float(totals["finished_episodes"][a]) if n else 0.0
-            row = {"game": game, "seed": seed, "step": step, "update": update, "wall_s": round(wall_s, 2),
+            split = {} if self.splits is None else {"split": self.splits[i]}
+            row = {"game": game, "seed": seed, **split, "step": step, "update": update, "wall_s": round(wall_s, 2),
                    "env_steps_per_s": round(step * num_agents / train_s, 1) if train_s else math.nan,
                    **self.eval_cells(evaluation, i, game),
                    "train_episode_return": (float(totals["finished_return_sum"][a]) / episodes
@@ -111,7 +119,7 @@ class ProgressLog:
 
 def _cell(column: str, text: str):
     """A CSV cell back as the value it was written from."""
-    if column == "game":
+    if column in ("game", "split"):
         return text
     try:
         return int(text)

@@ -36,7 +36,7 @@ from octax_gym.train.seats import SeatLanes
 
 
 def train(config: TrainConfig, out_dir, *, roms: Optional[Sequence] = None, progress: bool = True,
-          resume: bool = False) -> dict:
+          resume: bool = False, eval_roms: Optional[Sequence] = None) -> dict:
     """Trains every agent of `config`; writes config.json, progress.csv, learning_curve.png,
     agents/<game>-seed<s>.msgpack (and, with `save_at_evals`, `<game>-seed<s>-step<N>.msgpack` at every
     evaluation) and summary.json to `out_dir`. Returns the summary (paths, env
@@ -44,6 +44,7 @@ def train(config: TrainConfig, out_dir, *, roms: Optional[Sequence] = None, prog
 
     Args:
         roms: explicit ROM paths, one per game (for GameSpecs of your own; None: the ROM store's).
+        eval_roms: the same for `config.eval_games`.
         resume: continue the run in `out_dir` from its last checkpoint (`checkpoint_every`).
     """
     config.check()
@@ -52,19 +53,20 @@ def train(config: TrainConfig, out_dir, *, roms: Optional[Sequence] = None, prog
     if config.selfplay:  # both seats of one two-player game as lanes (seats.py)
         lanes = SeatLanes(config.games, dict(config.env_overrides), config.eval_noop_max, roms)
     else:
-        lanes = Lanes(config.games, dict(config.env_overrides), config.eval_noop_max, roms)  # refuses a bad mix
+        lanes = Lanes(config.games, dict(config.env_overrides), config.eval_noop_max, roms,  # refuses a bad mix
+                      config.eval_games, eval_roms)
     out_dir.mkdir(parents=True, exist_ok=True)
     trainer = make_trainer(config, lanes)
     rows = config.agents  # (game, seed) of each evaluation row
     num_agents = len(config.agent_names)
     options = lanes.compiler_options  # every jit that steps the env takes its platform's options
-    eval_steps = config.eval_max_steps or int(np.asarray(lanes.params.max_episode_steps).max())
+    eval_steps = config.eval_max_steps or int(np.asarray(lanes.eval_params.max_episode_steps).max())
     row_agents = np.asarray(config.row_agents)
     log_columns = {}
     if config.selfplay:  # matches against random and scripted players, on the host (selfplay.py)
         evaluate = selfplay.make_evaluate(lanes, trainer.network, config.eval_envs, eval_steps)
         log_columns = {"eval_columns": selfplay.EVAL_COLUMNS, "eval_cells": selfplay.evaluation_cells}
-    elif config.multitask:  # each seed's one agent plays every game's evaluation
+    elif config.multitask or config.eval_games:  # each agent plays several rows' games (its own, the eval_games)
         evaluate_rows = over_agents(make_evaluate(lanes, trainer, config.eval_envs, eval_steps), len(rows),
                                     config.agent_map)
         evaluate = jax.jit(lambda params, keys, games: evaluate_rows(
@@ -75,15 +77,16 @@ def train(config: TrainConfig, out_dir, *, roms: Optional[Sequence] = None, prog
 
     if not resume and writer:
         (out_dir / "config.json").write_text(json.dumps(
-            {"command": sys.argv, **dataclasses.asdict(config), "games": config.game_ids}, indent=2, default=str)
+            {"command": sys.argv, **dataclasses.asdict(config), "games": config.game_ids,
+             "eval_games": config.eval_game_ids}, indent=2, default=str)
             + "\n")
-    row_games = np.repeat(np.arange(len(config.games)), config.num_seeds)  # game-major, as config.agents
+    row_games = np.repeat(np.arange(len(config.games) + len(config.eval_games)), config.num_seeds)  # as config.agents
     if config.multitask:  # lane i of every agent plays game i mod G
         games = [np.arange(config.num_envs) % len(config.games)] * config.num_seeds
         train_keys = agent_keys(config.seeds)[0]
     else:
-        games = row_games
-        train_keys = agent_keys([seed for _, seed in rows])[0]
+        games = row_games[:num_agents]  # the trained games' rows come first, one per agent
+        train_keys = agent_keys([seed for _, seed in rows[:num_agents]])[0]
     eval_keys = agent_keys([seed for _, seed in rows])[1]
     runner = init_agents(trainer.init, train_keys, games)
     checkpoints = Checkpoints(out_dir / "resume", write=writer)
@@ -110,7 +113,8 @@ def train(config: TrainConfig, out_dir, *, roms: Optional[Sequence] = None, prog
     title = (f"{'multi-task ' * config.multitask}{'self-play ' * config.selfplay}{trainer.name}, {len(config.games)} game{'s' * (len(config.games) > 1)} x {config.num_seeds} "
              f"seed{'s' * (config.num_seeds > 1)} ({config.num_envs} envs x {config.num_steps} steps)")
     log = ProgressLog(out_dir, rows, trainer.metric_names, row_agents,
-                      keep_until=None if start_at is None else start_at["update"], write=writer, **log_columns)
+                      keep_until=None if start_at is None else start_at["update"], write=writer,
+                      splits=config.row_splits if config.eval_games else None, **log_columns)
     bar = tqdm(total=config.num_updates * config.batch_size * num_agents, unit="step", unit_scale=True,
                disable=not progress or not writer, desc=f"{trainer.name} x{num_agents}")
     if start_at is not None:
@@ -131,11 +135,15 @@ def train(config: TrainConfig, out_dir, *, roms: Optional[Sequence] = None, prog
     bar.close()
     steps_per_s = config.num_updates * config.batch_size * num_agents / train_s
     summary = report.summarize(log.rows, config.game_ids, config.seeds)
+    if config.eval_games:  # the same at the end for the games never trained on
+        summary["eval"] = report.summarize(log.rows, config.eval_game_ids, config.seeds)
     if writer:
         report.write({**summary, "env_steps_per_s": steps_per_s, "train_s": train_s}, out_dir / "summary.json")
     print(f"training speed: {steps_per_s:,.0f} env steps/s of {num_agents} agent(s) together "
           f"(rollout, targets and epochs; compile and evaluation excluded); wall {time.perf_counter() - start:.0f} s")
     print(report.table(summary))
+    if config.eval_games:
+        print("games never trained on (eval_games):\n" + report.table(summary["eval"]))
     return {**summary, "out_dir": out_dir, "csv": log.csv_path, "png": out_dir / "learning_curve.png",
             "agent_paths": [out_dir / "agents" / f"{name}.msgpack" for name in config.agent_names],
             "env_steps_per_s": steps_per_s, "train_s": train_s, "rows": log.rows,
