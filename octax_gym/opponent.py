@@ -120,7 +120,7 @@ def actions_of_both(env, view: View, step_keys: jax.Array, state, learner: jax.A
     if view.opponent == "callable":
         theirs = given
     else:
-        player = players.make_player(view.opponent, env.spec)
+        player = players.make_player(view.opponent, env.spec, env.mirrored)
         open_now = jax.vmap(env.legal_action_mask)(state)[:, view.other]
         keys = jax.vmap(lambda key: jax.random.fold_in(key, OPPONENT_STREAM))(step_keys)
         theirs = jax.vmap(player, in_axes=(None, 0, None, 0, None, 0))(None, keys, None, state, jnp.int32(view.other),

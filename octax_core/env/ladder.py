@@ -1,7 +1,7 @@
 """The opponent ladder of a two-player game: fixed rungs, a compiled match, an Elo against the rungs.
 
     env, params = make_multi("Cycles")                              # autoreset=False: one game each
-    match = make_match(env, params, num_games=64, max_steps=4500, players=[agent, *ladder_players(env.spec)])
+    match = make_match(env, params, num_games=64, max_steps=4500, players=[agent, *ladder_players(env.spec, env.mirrored)])
     result = match(0, agent_params, 1 + k, None, key)              # agent vs rung k, half from each seat
     table = play_ladder(env, params, agent, agent_params, key, num_games=64, max_steps=4500)
 
@@ -44,9 +44,9 @@ def rungs(spec: GameSpec) -> tuple[str, ...]:
     return RUNGS if "scripted" in player_names(spec) else NO_SCRIPT_RUNGS
 
 
-def ladder_players(spec: GameSpec) -> list[Player]:
-    """The rungs' players, in `rungs(spec)`'s order."""
-    return [make_player(name, spec) for name in rungs(spec)]
+def ladder_players(spec: GameSpec, mirrored: bool = False) -> list[Player]:
+    """The rungs' players, in `rungs(spec)`'s order (`mirrored`: for an env made with `mirror=True`)."""
+    return [make_player(name, spec, mirrored) for name in rungs(spec)]
 
 
 class MatchResult(NamedTuple):
@@ -232,7 +232,7 @@ def play_ladder(env: MultiEnv, env_params, agent: Player, agent_params, key: jax
     names = [*ladder, *extra]
     if match is None:
         match = make_match(env, env_params, num_games, max_steps,
-                           [agent, *(make_player(name, spec) for name in names)])
+                           [agent, *(make_player(name, spec, env.mirrored) for name in names)])
     index = {name: 1 + k for k, name in enumerate(names)}
     rows = []
     for k, name in enumerate(opponents):

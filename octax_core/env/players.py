@@ -58,22 +58,29 @@ def uniform(params, key, obs, state, seat, legal) -> jax.Array:
     return jax.random.categorical(key, jnp.where(legal, 0.0, -jnp.inf)).astype(jnp.int32)
 
 
-def scripted(spec: GameSpec) -> Player:
+def scripted(spec: GameSpec, mirrored: bool = False) -> Player:
     """The game's `Seats.scripted_policy` for a traced seat: the policy takes its seat as a Python
-    int, so both seats' actions are computed and the seat's one kept (a bot is a few compares)."""
+    int, so both seats' actions are computed and the seat's one kept (a bot is a few compares).
+
+    The bot reads the machine and answers in the game's own actions; in an env made with
+    `mirror=True` seat 1 plays the mirror image's actions (the env maps them back), so there
+    seat 1's answer is mapped through `Seats.mirror_actions` (its own inverse) first."""
     policy = _scripted_policy(spec, "scripted")
+    seat_action = jnp.asarray([range(len(spec.seats.action_keys[0]) + 1),
+                               spec.seats.mirror_actions if mirrored else range(len(spec.seats.action_keys[0]) + 1)],
+                              jnp.int32)
 
     def act(params, key, obs, state, seat, legal):
-        both = jnp.stack([jnp.asarray(policy(state.machine, s), jnp.int32) for s in (0, 1)])
+        both = jnp.stack([seat_action[s, jnp.asarray(policy(state.machine, s), jnp.int32)] for s in (0, 1)])
         return both[jnp.asarray(seat, jnp.int32)]
     return act
 
 
-def eps_scripted(spec: GameSpec, eps: float) -> Player:
+def eps_scripted(spec: GameSpec, eps: float, mirrored: bool = False) -> Player:
     """The scripted action, replaced with probability `eps` by `uniform`'s: eps 0 is `scripted`
     (the coin never falls below 0), eps 1 is `uniform` on the same draw (`pick`)."""
     eps = check_probability("eps", eps)
-    bot = scripted(spec)
+    bot = scripted(spec, mirrored)
 
     def act(params, key, obs, state, seat, legal):
         coin, pick = jax.random.split(key)
@@ -84,9 +91,9 @@ def eps_scripted(spec: GameSpec, eps: float) -> Player:
 
 # name -> spec -> player: the table every layer reads (`eps<p>` names are `eps_scripted`'s):
 # octax_gym's policies (one-player envs), its opponents, the web player's seats, the tracer, the ladder.
-PLAYERS: dict[str, Callable[[Optional[GameSpec]], Player]] = {
-    "random": lambda spec: uniform,
-    "noop": lambda spec: noop,
+PLAYERS: dict[str, Callable[..., Player]] = {  # (spec, mirrored=False) -> player
+    "random": lambda spec, mirrored=False: uniform,
+    "noop": lambda spec, mirrored=False: noop,
     "scripted": scripted,
 }
 SEATLESS = ("random", "noop")  # the players that read no seat, state or observation: any env's, one-player too
@@ -128,16 +135,19 @@ def check_player(name: Any, spec: Optional[GameSpec] = None) -> str:
                      + (hint if "scripted" in valid else ""))
 
 
-def make_player(name: str, spec: Optional[GameSpec]) -> Player:
+def make_player(name: str, spec: Optional[GameSpec], mirrored: bool = False) -> Player:
     """The table's player `name` ("random", "noop", "scripted", "eps<p>") for a game (`spec` None:
-    any env's, for the `SEATLESS` players).
+    any env's, for the `SEATLESS` players); `mirrored`: for an env made with `mirror=True`
+    (`MultiEnv.mirrored`), where seat 1 plays the mirror image's actions.
 
     Raises:
         ValueError: as `check_player`.
     """
     check_player(name, spec)
     eps = eps_of(name)
-    return eps_scripted(spec, eps) if eps is not None else PLAYERS[name](spec)
+    if mirrored and (spec is None or spec.seats is None or spec.seats.mirror_actions is None):
+        raise ValueError(f"mirrored: {getattr(spec, 'id', None)!r} declares no mirror image (Seats.mirror_actions)")
+    return eps_scripted(spec, eps, mirrored) if eps is not None else PLAYERS[name](spec, mirrored)
 
 
 def _scripted_policy(spec: Optional[GameSpec], name: str):

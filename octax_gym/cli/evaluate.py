@@ -122,7 +122,7 @@ def agent_player(agent: str, env, greedy: bool = True):
     except ValueError as exc:
         raise ValueError(f"--agent {agent!r} is no file and no player: pass a saved agent file (.msgpack) or a "
                          f"player name ({exc})") from None
-    return make_player(name, env.spec), None, name
+    return make_player(name, env.spec, env.mirrored), None, name
 
 
 def _network_player(path: Path, env, greedy: bool):

@@ -266,7 +266,8 @@ class Session:
         """The action of the table's player `name` (`octax_core.env.players`) in `seat`, from the
         env's state, the seat's observation and legal actions, and the session's next key."""
         if name not in self._table:
-            player = make_player(name, self.spec if self.two_player else None)
+            player = make_player(name, self.spec if self.two_player else None,
+                                 self.two_player and self.env.core_env.mirrored)
             self._table[name] = jax.jit(jax.vmap(player, in_axes=(None, 0, 0, 0, None, 0)))
         self.draws, draw = jax.random.split(self.draws)
         obs = self.obs[:, seat] if self.two_player else self.obs

@@ -152,3 +152,35 @@ def test_mirror_is_refused_where_there_is_no_mirrored_second_seat():
         octax_core.make_mix(["Cycles", "Cycles1"], mirror=True)
     with pytest.raises(ValueError, match="mirror must be"):
         octax_core.make_multi("Cycles", mirror="yes")
+
+
+def test_the_tables_players_play_the_same_game_in_a_mirrored_env():
+    """The scripted bot answers in the game's actions; in a mirrored env seat 1's answer is mapped
+    into its mirrored view (`make_player(..., mirrored=True)`), so the bots on both seats play the
+    same game, machine for machine, with and without mirroring; unmapped, seat 1's left and right
+    swap and the game is another. (A random player draws over the permuted view: an equally random,
+    different game.)"""
+    from octax_core.env.players import make_player
+
+    def play(mirror, mapped, steps=60):
+        env, params = octax_core.make_multi("Cycles", mirror=mirror)
+        bot = make_player("scripted", env.spec, env.mirrored and mapped)
+
+        @jax.jit
+        @jax.vmap
+        def step(key, state):
+            both = jnp.stack([bot(None, key, None, state, jnp.int32(seat), None) for seat in (0, 1)])
+            return env.step(key, state, both, params)[1]
+
+        _, state = jax.vmap(env.reset, in_axes=(0, None))(jax.random.split(jax.random.key(3), N), params)
+        registers = []
+        for t in range(steps):
+            state = step(jax.random.split(jax.random.key(100 + t), N), state)
+            registers.append(np.asarray(state.machine.V))
+        return np.stack(registers)
+
+    plain = play(False, True)
+    np.testing.assert_array_equal(play(True, True), plain)
+    assert not np.array_equal(play(True, False), plain)
+    with pytest.raises(ValueError, match="declares no mirror image"):
+        make_player("scripted", get_spec("Paddles"), mirrored=True)
