@@ -23,13 +23,13 @@ from pathlib import Path
 
 TRAIN_HINT = "pip install 'octax-gym[train]'"
 ALGORITHMS = ("ppo", "pqn", "multitask", "selfplay", "bc", "cql")
-PPO_ONLY = ("gae_lambda", "clip_eps", "clip_value_loss", "vf_coef", "ent_coef")
+PPO_ONLY = ("gae_lambda", "clip_eps", "clip_value_loss", "vf_coef", "ent_coef", "ent_coef_final")
 EXPLORATION = ("q_lambda", "epsilon_start", "epsilon_finish", "epsilon_fraction")
 PQN_ONLY = EXPLORATION + ("eval_epsilon",)  # eval_epsilon: CQL's too
 MULTITASK_ONLY = ("game_input",)
 OFFLINE_ONLY = ("dataset",)
 CQL_ONLY = ("cql_alpha", "target_every")
-SELFPLAY_ONLY = ("pool", "pool_prob")
+SELFPLAY_ONLY = ("pool", "pool_prob", "eval_opponents")
 NOT_OF = {"ppo": PQN_ONLY + MULTITASK_ONLY + OFFLINE_ONLY + CQL_ONLY + SELFPLAY_ONLY,
           "pqn": PPO_ONLY + MULTITASK_ONLY + OFFLINE_ONLY + CQL_ONLY + SELFPLAY_ONLY,
           "multitask": PQN_ONLY + OFFLINE_ONLY + CQL_ONLY + SELFPLAY_ONLY,
@@ -57,6 +57,8 @@ SETTINGS = {  # flag -> (type, help); each a TrainConfig field
     "clip_eps": (float, "PPO: ratio (and value) clip"),
     "vf_coef": (float, "PPO: value loss weight"),
     "ent_coef": (float, "PPO: entropy bonus weight"),
+    "ent_coef_final": (float, "PPO: the entropy weight decays linearly from --ent-coef to this over the run "
+                              "(default: constant)"),
     "q_lambda": (float, "PQN: lambda of the Q(lambda) returns"),
     "epsilon_start": (float, "PQN: exploration rate of the first rollout"),
     "epsilon_finish": (float, "PQN: exploration rate after the decay"),
@@ -67,6 +69,9 @@ SETTINGS = {  # flag -> (type, help); each a TrainConfig field
     "target_every": (int, "CQL: updates between copies of the target network"),
     "pool": (int, "selfplay: K past selves (a snapshot per evaluation) as opponents; 0: pure self-play"),
     "pool_prob": (float, "selfplay: per env and update, the chance that one seat is played by a past self"),
+    "eval_opponents": (lambda text: tuple(name.strip() for name in text.split(",")),
+                       "selfplay: the evaluation's opponents, comma-separated players (ladder rungs random, eps0.5, "
+                       "eps0.25, eps0.1, scripted; noop; eps<p>); default random,eps0.5,scripted"),
 }
 
 
@@ -211,6 +216,8 @@ def _resumed(args: argparse.Namespace):
     values["games"] = tuple(values["games"])
     values["eval_games"] = tuple(values.get("eval_games", ()))
     values["env_overrides"] = tuple(tuple(pair) for pair in values.get("env_overrides", ()))
+    if "eval_opponents" in values:
+        values["eval_opponents"] = tuple(values["eval_opponents"])
     if values["algorithm"] != args.algorithm:
         raise ValueError(f"--resume: {args.resume} is a {values['algorithm']} run, not {args.algorithm}")
     return TrainConfig(**values).check(), args.resume

@@ -61,6 +61,7 @@ class TrainConfig:
     clip_value_loss: bool = True  # CleanRL's Atari PPO and the paper's Rejax-based code clip it
     vf_coef: float = 0.5
     ent_coef: float = 0.01
+    ent_coef_final: Optional[float] = None  # the entropy weight decays linearly to it over the run; None: constant
     # PQN's
     q_lambda: float = 0.9
     epsilon_start: float = 1.0
@@ -72,6 +73,8 @@ class TrainConfig:
     # selfplay's
     pool: int = 0  # K past selves (one snapshot per evaluation) as opponents; 0: pure self-play
     pool_prob: float = 0.5  # per env and update, the chance that one seat is played by a drawn past self
+    eval_opponents: tuple = ("random", "eps0.5", "scripted")  # the evaluation's matches: players of
+    # octax_core.env.players (the ladder's rungs among them), weakest first; one the game lacks: nan cells
     # offline (bc, cql)
     dataset: str = ""  # the Minari dataset id trained on; the run's game and env options are the dataset's
     cql_alpha: float = 1.0  # weight of CQL's regulariser
@@ -145,6 +148,16 @@ class TrainConfig:
             return self.learning_rate
         return self.learning_rate * max(0.0, 1.0 - update / self.num_updates)
 
+    def ent_coef_at(self, update: Any) -> Any:
+        """PPO's entropy weight in update `update` (from 0): `ent_coef`, or with `ent_coef_final` linear
+        from `ent_coef` to it over the run (a policy that starts curious and ends nearly greedy)."""
+        if self.ent_coef_final is None:
+            return self.ent_coef
+        import jax.numpy as jnp
+
+        progress = jnp.minimum(1.0, jnp.asarray(update, jnp.float32) / self.num_updates)
+        return self.ent_coef + (self.ent_coef_final - self.ent_coef) * progress
+
     def epsilon(self, update: Any) -> Any:
         """PQN's exploration rate in update `update`: linear in the env steps done before it, from
         epsilon_start to epsilon_finish at epsilon_fraction of the run, then constant."""
@@ -202,6 +215,14 @@ class TrainConfig:
         _at_least("pool", self.pool, 0)
         if self.pool and not self.selfplay:
             raise ValueError(f"pool is a setting of selfplay, not of {self.algorithm}")
+        if self.ent_coef_final is not None:
+            if self.algorithm not in ("ppo", "multitask", "selfplay"):
+                raise ValueError(f"ent_coef_final is a setting of PPO (ppo, multitask, selfplay), not of "
+                                 f"{self.algorithm}")
+            if isinstance(self.ent_coef_final, bool) or not self.ent_coef_final >= 0:
+                raise ValueError(f"ent_coef_final must be >= 0, got {self.ent_coef_final!r}")
+        if not self.selfplay and self.eval_opponents != TrainConfig.eval_opponents:
+            raise ValueError(f"eval_opponents is a setting of selfplay, not of {self.algorithm}")
         if self.selfplay:
             if len(self.games) != 1:
                 raise ValueError(f"selfplay trains on one two-player game; got games {', '.join(self.game_ids)}")
@@ -216,6 +237,14 @@ class TrainConfig:
                                  "from each seat)")
             if self.devices:
                 raise ValueError("devices must be '' for selfplay (its two-seat envs run on one device)")
+            from octax_core.env.players import check_player
+
+            if not self.eval_opponents:
+                raise ValueError("selfplay: eval_opponents must name at least one player (e.g. random,eps0.5,scripted)")
+            for name in self.eval_opponents:
+                check_player(name)  # any game's name (the message lists them); one the game lacks gives nan cells
+            if len(set(self.eval_opponents)) != len(self.eval_opponents):
+                raise ValueError(f"selfplay: eval_opponents names a player twice: {', '.join(self.eval_opponents)}")
         if self.eval_games:
             self._check_eval_games()
         if self.multitask and self.num_envs % len(self.games):

@@ -11,7 +11,7 @@ those updates. A resumed run rewrites the file with the rows up to its checkpoin
 A run with `eval_games` (games its agents never train on) has a `split` column after `seed`: "train"
 for a row of a game the agent trains on, "eval" for one of those.
 
-A self-play run's evaluation columns are its matches' (selfplay.py's `EVAL_COLUMNS`: win, draw,
+A self-play run's evaluation columns are its matches' (selfplay.py's `eval_columns`: win, draw,
 loss and margin against each opponent, greedy and sampled) in place of the one-player ones
 (`EVAL_COLUMNS` here); the other columns are the same.
 """

@@ -63,9 +63,11 @@ def train(config: TrainConfig, out_dir, *, roms: Optional[Sequence] = None, prog
     eval_steps = config.eval_max_steps or int(np.asarray(lanes.eval_params.max_episode_steps).max())
     row_agents = np.asarray(config.row_agents)
     log_columns = {}
-    if config.selfplay:  # matches against random and scripted players, on the host (selfplay.py)
-        evaluate = selfplay.make_evaluate(lanes, trainer.network, config.eval_envs, eval_steps)
-        log_columns = {"eval_columns": selfplay.EVAL_COLUMNS, "eval_cells": selfplay.evaluation_cells}
+    if config.selfplay:  # matches against the eval_opponents, on the host (selfplay.py)
+        opponents = config.eval_opponents
+        evaluate = selfplay.make_evaluate(lanes, trainer.network, config.eval_envs, eval_steps, opponents)
+        log_columns = {"eval_columns": selfplay.eval_columns(opponents),
+                       "eval_cells": lambda result, i, game: selfplay.evaluation_cells(result, i, opponents)}
     elif config.multitask or config.eval_games:  # each agent plays several rows' games (its own, the eval_games)
         evaluate_rows = over_agents(make_evaluate(lanes, trainer, config.eval_envs, eval_steps), len(rows),
                                     config.agent_map)

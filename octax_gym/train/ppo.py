@@ -86,6 +86,8 @@ def make_trainer(config: TrainConfig, lanes: Lanes) -> Trainer:
         advantages, targets = gae(traj.reward, traj.done, old.value, last_value, config.gamma, config.gae_lambda)
         games = jnp.broadcast_to(runner.game, traj.action.shape)  # each sample's game: its input (multitask)
         batch = (traj.obs, games, traj.legal, traj.action, old.log_prob, old.value, advantages, targets, old.weight)
+        if config.ent_coef_final is not None:  # this update's entropy weight, a column so the loss reads it
+            batch += (jnp.full(traj.action.shape, config.ent_coef_at(runner.updates), jnp.float32),)
         return runner, batch, shared.episode_totals(traj)
 
     def greedy(params, key, obs, game):
@@ -99,8 +101,10 @@ def make_trainer(config: TrainConfig, lanes: Lanes) -> Trainer:
         from octax_gym.train import selfplay
 
         init = selfplay.with_pool(config, init)
-    return Trainer("PPO", network, init, collect, learn, greedy, sampled, METRICS,
-                   lambda i: {"learning_rate": config.learning_rate_at(i)})
+    annealed = config.ent_coef_final is not None
+    return Trainer("PPO", network, init, collect, learn, greedy, sampled, METRICS + ("ent_coef",) * annealed,
+                   lambda i: {"learning_rate": config.learning_rate_at(i),
+                              **({"ent_coef": float(config.ent_coef_at(i))} if annealed else {})})
 
 
 def gae(reward: jax.Array, done: jax.Array, value: jax.Array, last_value: jax.Array, gamma: float, lam: float):
@@ -122,8 +126,11 @@ def gae(reward: jax.Array, done: jax.Array, value: jax.Array, last_value: jax.Ar
 def ppo_loss(params, apply, config: TrainConfig, minibatch):
     """The clipped surrogate, the (clipped) value loss and the entropy bonus, over logits masked to
     each sample's legal actions (`apply(params, obs, game, legal) -> (masked logits, values)`),
-    every mean (the advantages' normalisation too) weighted by the samples' weights."""
-    obs, game, legal, action, old_log_prob, old_value, advantage, target, weight = minibatch
+    every mean (the advantages' normalisation too) weighted by the samples' weights. With
+    `ent_coef_final` the minibatch ends with each sample's entropy weight (the update's, `ent_coef_at`);
+    without it the batch is as it was and the weight `ent_coef`."""
+    obs, game, legal, action, old_log_prob, old_value, advantage, target, weight, *scheduled = minibatch
+    ent_coef = scheduled[0][0] if scheduled else config.ent_coef
     logits, value = apply(params, obs, game, legal)
     # Only a pool's past selves weigh 0: without one every weight is 1, and the plain means are
     # kept, so that ppo and multitask runs stay bit for bit what they were (the weighted form of
@@ -148,7 +155,7 @@ def ppo_loss(params, apply, config: TrainConfig, minibatch):
         v_clipped = old_value + jnp.clip(value - old_value, -config.clip_eps, config.clip_eps)
         v_loss = jnp.maximum(v_loss, jnp.square(v_clipped - target))
     v_loss = 0.5 * mean(v_loss)
-    loss = pg_loss + config.vf_coef * v_loss - config.ent_coef * entropy
+    loss = pg_loss + config.vf_coef * v_loss - ent_coef * entropy
     stats = {"pg_loss": pg_loss, "v_loss": v_loss, "entropy": entropy,
              "approx_kl": mean((ratio - 1) - log_ratio),
              "clip_frac": mean(jnp.abs(ratio - 1) > config.clip_eps)}

@@ -15,19 +15,20 @@ another policy, so their weight in ppo_loss is 0; the env's other seat trains as
 pure self-play: the current params on both seats, every sample trains.
 
 The evaluation (`make_evaluate`) plays matches, `octax_core.env.ladder`'s one compiled match: the
-agent, greedy (the largest legal logit) and sampled (its policy as trained), against the table's
-`random` (uniform over legal actions) and the game's `scripted` player (`octax_core.env.players`,
-where the game has one), `eval_envs` games each, half from each seat, each to its end or
-`eval_max_steps`, from no-op starts. The network player takes its params as an argument, so one
-compiled match serves every evaluation and seed. A game is won when the agent's return (the
-change of its seat's score) beats the opponent's. The rows (`EVAL_COLUMNS`, in progress.csv where
-a one-player run has its returns):
+agent, greedy (the largest legal logit) and sampled (its policy as trained), against each of
+`eval_opponents` (`--eval-opponents`, players of `octax_core.env.players`, weakest first; by default
+the ladder's `random`, `eps0.5` and `scripted` rungs, so a run shows the rung it climbs to, not only
+the two ends), `eval_envs` games each, half from each seat, each to its end or `eval_max_steps`,
+from no-op starts. The network player takes its params as an argument, so one compiled match
+serves every evaluation and seed. A game is won when the agent's return (the change of its seat's
+score) beats the opponent's. The rows (`eval_columns(config.eval_opponents)`, in progress.csv
+where a one-player run has its returns):
 
 * `eval_mean_return`, `eval_greedy_return`: the sampled and greedy agent's mean return against the
-  strongest opponent played (`scripted`, or `random` where the game has no scripted player).
-* `<policy>_vs_<opponent>_<stat>` for policy greedy, sampled, opponent random, scripted and stat
-  `win`, `draw`, `loss` (fractions of the games) and `margin` (the mean of the agent's return minus
-  the opponent's); nan for an opponent the game does not have.
+  strongest opponent the game has (the last of `eval_opponents` it has).
+* `<policy>_vs_<opponent>_<stat>` for policy greedy, sampled, each opponent and stat `win`, `draw`,
+  `loss` (fractions of the games) and `margin` (the mean of the agent's return minus the
+  opponent's); nan for an opponent the game does not have (a scripted one where it has none).
 * `eval_ended_frac`: the fraction of all those games that ended before the step cap.
 
 The Elo of an agent against the game's ladder of fixed rungs is `octax-gym evaluate GAME --agent
@@ -44,17 +45,31 @@ import jax
 import jax.numpy as jnp
 
 from octax_core.env import ladder
-from octax_core.env.players import Player, make_player, player_names
+from octax_core.env.players import Player, check_player, make_player
 from octax_gym.train.config import TrainConfig
 from octax_gym.train.networks import ACTIONS, masked
 from octax_gym.train.seats import SEATS, SeatLanes
 
-OPPONENTS = ("random", "scripted")
 POLICIES = ("greedy", "sampled")
 STATS = ("win", "draw", "loss", "margin")
-EVAL_COLUMNS = (("eval_mean_return", "eval_greedy_return")
-                + tuple(f"{policy}_vs_{opponent}_{stat}" for opponent in OPPONENTS for policy in POLICIES
-                        for stat in STATS) + ("eval_ended_frac",))
+
+
+def eval_columns(opponents) -> tuple[str, ...]:
+    """progress.csv's evaluation columns of a run evaluated against `opponents` (the module docstring)."""
+    return (("eval_mean_return", "eval_greedy_return")
+            + tuple(f"{policy}_vs_{opponent}_{stat}" for opponent in opponents for policy in POLICIES
+                    for stat in STATS) + ("eval_ended_frac",))
+
+
+def open_opponents(opponents, spec) -> list[str]:
+    """Those of `opponents` that the game has (a scripted player, and its eps<p> rungs, only where it has one)."""
+    def has(name):
+        try:
+            check_player(name, spec)
+        except ValueError:
+            return False
+        return True
+    return [name for name in opponents if has(name)]
 
 
 class Pool(NamedTuple):
@@ -103,13 +118,13 @@ def network_player(network, greedy: bool) -> Player:
     return act
 
 
-def make_evaluate(lanes: SeatLanes, network, num_games: int, max_steps: int) -> Callable:
+def make_evaluate(lanes: SeatLanes, network, num_games: int, max_steps: int, opponents) -> Callable:
     """`evaluate(params, keys, games) -> [per agent: {(policy, opponent): ladder.MatchResult}]`:
-    each agent (`params` stacked along the agent axis, `keys` one per agent) against each
-    opponent, greedy and sampled from the same starts (the same key). One match, compiled on first
-    use, plays them all."""
+    each agent (`params` stacked along the agent axis, `keys` one per agent) against each of
+    `opponents` that the game has, greedy and sampled from the same starts (the same key). One
+    match, compiled on first use, plays them all."""
     spec = lanes.spec
-    opponents = [name for name in OPPONENTS if name in player_names(spec)]
+    opponents = open_opponents(opponents, spec)
     players = [network_player(network, True), network_player(network, False),
                *(make_player(name, spec) for name in opponents)]
     match = ladder.make_match(lanes.eval_env, lanes.eval_params, num_games, max_steps, players)
@@ -129,14 +144,14 @@ def make_evaluate(lanes: SeatLanes, network, num_games: int, max_steps: int) -> 
     return evaluate
 
 
-def evaluation_cells(evaluation: list, i: int, game: str) -> dict:
-    """Row `i`'s `EVAL_COLUMNS` from `make_evaluate`'s results (see the module docstring)."""
+def evaluation_cells(evaluation: list, i: int, opponents) -> dict:
+    """Row `i`'s `eval_columns(opponents)` from `make_evaluate`'s results (see the module docstring)."""
     results = evaluation[i]
-    top = "scripted" if ("sampled", "scripted") in results else "random"
+    top = [name for name in opponents if ("sampled", name) in results][-1]  # the strongest the game has
     cells = {"eval_mean_return": float(results["sampled", top].return_a.mean()),
              "eval_greedy_return": float(results["greedy", top].return_a.mean())}
     ended = []
-    for opponent in OPPONENTS:
+    for opponent in opponents:
         for policy in POLICIES:
             record = ladder.record(results[policy, opponent]) if (policy, opponent) in results else {}
             ended += [float(e) for e in results[policy, opponent].ended] if record else []

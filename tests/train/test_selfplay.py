@@ -1,6 +1,7 @@
 """Self-play, the trainer's `selfplay` configuration, on the tiny two-player test games
 (tests/two_player_games.py): TwoCounters (simultaneous, with a scripted player) trains a TINY
-run; TakeTurns (turn-based) checks that the rollout takes its legal masks from the env's state."""
+run (with a pool, the rate and the entropy weight annealed, evaluated against three rungs);
+TakeTurns (turn-based) checks that the rollout takes its legal masks from the env's state."""
 
 from __future__ import annotations
 
@@ -37,7 +38,7 @@ POOLED = dict(pool=2, pool_prob=1.0)
 @pytest.fixture(scope="module")
 def runs(two_counters_rom, tmp_path_factory):
     """A TINY run with a pool of past selves, and the same run again (the same seed), each in its folder."""
-    config = tiny(save_at_evals=True, pool=2)
+    config = tiny(save_at_evals=True, pool=2, anneal_lr=True, ent_coef_final=0.002)
     return [train(config, tmp_path_factory.mktemp("selfplay") / "run", roms=[two_counters_rom], progress=False)
             for _ in range(2)]
 
@@ -51,14 +52,57 @@ def test_a_row_per_evaluation_with_the_matches_columns(run):
     rows = run["rows"]
     assert [r["step"] for r in rows] == STEPS and {r["game"] for r in rows} == {"TwoCounters"}
     header = run["csv"].read_text().splitlines()[0].split(",")
-    assert all(column in header for column in selfplay.EVAL_COLUMNS) and "normalized_score" not in header
+    opponents = ("random", "eps0.5", "scripted")  # the default: the ladder's ends and a rung between
+    assert all(column in header for column in selfplay.eval_columns(opponents)) and "normalized_score" not in header
     for row in rows:
         for policy in selfplay.POLICIES:
-            for opponent in selfplay.OPPONENTS:  # TwoCounters has a scripted player: every cell is a number
+            for opponent in opponents:  # TwoCounters has a scripted player (and so eps0.5): every cell is a number
                 rates = [row[f"{policy}_vs_{opponent}_{stat}"] for stat in ("win", "draw", "loss")]
                 assert math.isclose(sum(rates), 1.0) and all(0 <= r <= 1 for r in rates)
         # the scripted player holds its 2-key: against it an agent's return is its own count, the margin below it
         assert row["eval_mean_return"] - row["sampled_vs_scripted_margin"] >= 0
+
+
+def test_the_rate_and_the_entropy_weight_decay_linearly_over_the_run(run):
+    # 6 updates; the rows are evaluations at updates 0, 2, 4, 6: the weight during the update after each
+    np.testing.assert_allclose([r["learning_rate"] for r in run["rows"]], [5e-4 * (1 - u / 6) for u in (0, 2, 4, 6)])
+    np.testing.assert_allclose([r["ent_coef"] for r in run["rows"]],
+                               [0.01 + (0.002 - 0.01) * u / 6 for u in (0, 2, 4, 6)], rtol=1e-6)
+
+
+def test_the_loss_takes_the_updates_entropy_weight_from_the_batch(pooled):
+    """With ent_coef_final the batch ends with the update's weight, and the loss uses it, not ent_coef."""
+    from octax_gym.train.networks import masked
+    from octax_gym.train.ppo import ppo_loss
+
+    config, _, trainer, _, (after, batch, _) = pooled
+    flat = tuple(jax.tree.map(lambda x: x.reshape((-1,) + x.shape[2:]), batch))
+
+    def apply(params, obs, game, legal):
+        logits, value = trainer.network.apply(params, obs)
+        return masked(logits, legal), value
+
+    loss = jax.jit(lambda minibatch: ppo_loss(after.params, apply, config, minibatch))
+    plain, stats = loss(flat)
+    annealed, _ = loss(flat + (jnp.full(flat[3].shape, 0.004, jnp.float32),))
+    np.testing.assert_allclose(annealed - plain, (config.ent_coef - 0.004) * stats["entropy"], rtol=1e-4)
+
+
+def test_the_entropy_weight_is_constant_without_ent_coef_final():
+    config = tiny()
+    assert config.ent_coef_final is None and config.ent_coef_at(3) == config.ent_coef == 0.01
+    config = tiny(ent_coef_final=0.0)
+    ends = [config.ent_coef_at(u) for u in (0, config.num_updates // 2, config.num_updates, 10 * config.num_updates)]
+    np.testing.assert_allclose(ends, [0.01, 0.005, 0.0, 0.0], rtol=1e-6)  # past the end: the final weight
+
+
+def test_a_game_without_a_scripted_player_is_evaluated_against_the_opponents_it_has():
+    from octax_core.env.games import get_spec
+
+    opponents = ("random", "eps0.5", "scripted")
+    assert selfplay.open_opponents(opponents, get_spec("SpaceRacer")) == ["random"]
+    assert selfplay.open_opponents(opponents, TWO_COUNTERS) == list(opponents)
+    assert "greedy_vs_eps0.25_margin" in selfplay.eval_columns(("random", "eps0.25"))
 
 
 def test_params_change_and_agents_are_saved_as_the_loop_saves_them(run):
@@ -165,6 +209,14 @@ def test_turn_based_legal_masks_come_from_the_state_and_are_honoured(take_turns_
     (["selfplay", "--game", "Cycles", "--pool-prob", "2"], "pool_prob must be in [0, 1], got 2.0"),
     (["selfplay", "--game", "Cycles", "--pool", "-1"], "pool must be an int >= 0, got -1"),
     (["ppo", "--game", "Airplane", "--pool", "2"], "--pool: not a setting of ppo (of selfplay)"),
+    (["selfplay", "--game", "Cycles", "--eval-opponents", "random,best"], "unknown player 'best'; valid: 'random', "
+                                                                          "'noop', 'scripted', or 'eps<p>'"),
+    (["selfplay", "--game", "Cycles", "--eval-opponents", "random,random"], "eval_opponents names a player twice"),
+    (["selfplay", "--game", "Cycles", "--eval-opponents", "eps2"], "the eps of 'eps2' must be"),
+    (["ppo", "--game", "Airplane", "--eval-opponents", "random"], "--eval-opponents: not a setting of ppo (of "
+                                                                  "selfplay)"),
+    (["selfplay", "--game", "Cycles", "--ent-coef-final", "-0.1"], "ent_coef_final must be >= 0, got -0.1"),
+    (["pqn", "--game", "Airplane", "--ent-coef-final", "0.001"], "--ent-coef-final: not a setting of pqn"),
 ])
 def test_bad_selfplay_flags_are_refused_by_name(flags, message, capsys, tmp_path, monkeypatch):
     from octax_gym.cli import main
