@@ -113,6 +113,9 @@ def add_commands(commands: argparse._SubParsersAction) -> None:
     for name, kind in ENV_FLAGS.items():
         train.add_argument("--" + name.replace("_", "-"), type=kind, default=None,
                            help="an env option for every game (octax_core.make); default: the game's")
+    train.add_argument("--mirror", action="store_true", default=None,
+                       help="selfplay, a game whose sides mirror each other (Cycles): seat 1 sees and plays the "
+                            "mirror image (make_multi(mirror=True)), so the network plays both seats from one side")
     train.add_argument("--devices", default=None, metavar="all",
                        help="all: every agent's envs split over every device (data-parallel); default one device")
     train.add_argument("--coordinator", default=None, metavar="HOST:PORT",
@@ -163,6 +166,8 @@ def config_from_args(args: argparse.Namespace):
         if getattr(args, name) is not None:
             given[name] = getattr(args, name)
     overrides = tuple((name, getattr(args, name)) for name in ENV_FLAGS if getattr(args, name) is not None)
+    if args.mirror:
+        overrides += (("mirror", True),)
     if overrides and "dataset" in given:
         raise ValueError(f"--{overrides[0][0].replace('_', '-')}: an offline run plays the env its dataset was "
                          "collected in (its options are the dataset's)")
@@ -197,7 +202,7 @@ def _resumed(args: argparse.Namespace):
     """The config of the run in `--resume OUT` (its config.json); refuses other settings."""
     defaults = {"games": None, "eval_games": None, "preset": "cpu", "devices": None, "agent_map": None,
                 "out_dir": None, "anneal_lr": None,
-                "clip_value_loss": None, "game_input": None, "save_at_evals": None,
+                "clip_value_loss": None, "game_input": None, "save_at_evals": None, "mirror": None,
                 **{n: None for n in (*SETTINGS, *ENV_FLAGS)}}
     if given := [name for name, default in defaults.items() if getattr(args, name) != default]:
         raise ValueError(f"--resume takes the run's own settings (OUT/config.json); drop "

@@ -21,7 +21,8 @@ DEVICES = ("", "all")
 ARCHIVE = "archive:"  # in games: archive:DIR[:SPLIT|:NAME], an `octax-gym generate` archive's games
 AGENT_MAPS = ("auto", "vmap", "map")
 ENV_FLAGS = {"max_episode_steps": int, "frames_per_step": int, "repeat_action_probability": float,
-             "noop_max": int}  # octax_core.make options a run may override (for every game alike)
+             "noop_max": int,  # octax_core.make options a run may override (for every game alike)
+             "mirror": bool}  # make_multi's: selfplay's seat 1 sees and plays the mirror image (--mirror)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -215,6 +216,9 @@ class TrainConfig:
         _at_least("pool", self.pool, 0)
         if self.pool and not self.selfplay:
             raise ValueError(f"pool is a setting of selfplay, not of {self.algorithm}")
+        mirror = dict(self.env_overrides).get("mirror", False)
+        if mirror and not self.selfplay:
+            raise ValueError(f"mirror is a setting of selfplay (a two-player game's seats), not of {self.algorithm}")
         if self.ent_coef_final is not None:
             if self.algorithm not in ("ppo", "multitask", "selfplay"):
                 raise ValueError(f"ent_coef_final is a setting of PPO (ppo, multitask, selfplay), not of "
@@ -237,6 +241,11 @@ class TrainConfig:
                                  "from each seat)")
             if self.devices:
                 raise ValueError("devices must be '' for selfplay (its two-seat envs run on one device)")
+            if mirror and (spec.seats.mirror is None):
+                from octax_core.env.config import mirrored_games
+
+                raise ValueError(f"selfplay: {spec.id} has no mirrored seats (Seats.mirror); mirror is for "
+                                 f"{', '.join(mirrored_games())}")
             from octax_core.env.players import check_player
 
             if not self.eval_opponents:

@@ -13,6 +13,11 @@ no code of its own; only the env state is per env, (N, ...). The legal masks com
 (`MultiEnv.legal_action_mask`: in a turn-based game the seat not to move has only no-op), padded
 to the networks' `ACTIONS` outputs, where `Lanes.legal_mask` gives a one-player game's static row.
 
+With the `mirror` override (`--mirror`, a game with `Seats.mirror`: Cycles) both envs are
+`make_multi(..., mirror=True)`: seat 1's lanes see the screen flipped and play the mirror image's
+actions, so the one network plays both seats from seat 0's side (its player plane still tells
+them apart); the evaluation's scripted opponents are made for that env (selfplay.py).
+
 The training env autoresets (`Env.step`: the next episode drawn with the step's reset key); the
 evaluation (selfplay.py) plays whole matches in a second env made without autoreset and with
 `eval_noop_max` no-op starts, as the one-player evaluation's.

@@ -45,7 +45,7 @@ import jax
 import jax.numpy as jnp
 
 from octax_core.env import ladder
-from octax_core.env.players import Player, check_player, make_player
+from octax_core.env.players import Player, check_player, make_player, player_names
 from octax_gym.train.config import TrainConfig
 from octax_gym.train.networks import ACTIONS, masked
 from octax_gym.train.seats import SEATS, SeatLanes
@@ -118,15 +118,25 @@ def network_player(network, greedy: bool) -> Player:
     return act
 
 
+def evaluation_opponents(lanes: SeatLanes, opponents) -> list[tuple[str, Player]]:
+    """(name, player) of each of `opponents` the game has, for the evaluation env: in a mirrored
+    one (`--mirror`) the scripted players answer seat 1 in its mirror image (`make_player`'s
+    `mirrored`), as the network, which sees and plays it, does."""
+    return [(name, make_player(name, lanes.spec, lanes.eval_env.mirrored))
+            for name in open_opponents(opponents, lanes.spec)]
+
+
 def make_evaluate(lanes: SeatLanes, network, num_games: int, max_steps: int, opponents) -> Callable:
     """`evaluate(params, keys, games) -> [per agent: {(policy, opponent): ladder.MatchResult}]`:
     each agent (`params` stacked along the agent axis, `keys` one per agent) against each of
     `opponents` that the game has, greedy and sampled from the same starts (the same key). One
     match, compiled on first use, plays them all."""
-    spec = lanes.spec
-    opponents = open_opponents(opponents, spec)
-    players = [network_player(network, True), network_player(network, False),
-               *(make_player(name, spec) for name in opponents)]
+    chosen = evaluation_opponents(lanes, opponents)
+    if not chosen:
+        raise ValueError(f"selfplay: {lanes.spec.id} has none of the eval_opponents {', '.join(opponents)}; its "
+                         f"players: {', '.join(player_names(lanes.spec))}")
+    opponents, opponent_players = zip(*chosen)
+    players = [network_player(network, True), network_player(network, False), *opponent_players]
     match = ladder.make_match(lanes.eval_env, lanes.eval_params, num_games, max_steps, players)
 
     def evaluate(params, keys, games) -> list[dict]:

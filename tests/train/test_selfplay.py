@@ -105,6 +105,22 @@ def test_a_game_without_a_scripted_player_is_evaluated_against_the_opponents_it_
     assert "greedy_vs_eps0.25_margin" in selfplay.eval_columns(("random", "eps0.25"))
 
 
+def test_mirror_makes_both_envs_mirrored_and_the_scripted_opponent_answers_in_the_mirror_image(two_counters_rom):
+    from types import SimpleNamespace
+
+    seats = dataclasses.replace(TWO_COUNTERS.seats, mirror="left-right", mirror_actions=(0, 2, 1))
+    mirrored = dataclasses.replace(TWO_COUNTERS, seats=seats)
+    config = dataclasses.replace(tiny(), games=(mirrored,), env_overrides=TINY["env_overrides"] + (("mirror", True),))
+    config.check()
+    lanes = SeatLanes(config.games, dict(config.env_overrides), roms=[two_counters_rom])
+    plain = SeatLanes((mirrored,), dict(TINY["env_overrides"]), roms=[two_counters_rom])
+    assert lanes.env.mirrored and lanes.eval_env.mirrored and not plain.eval_env.mirrored
+    state = SimpleNamespace(machine=None)  # TwoCounters' bot holds its key 2 whatever the machine
+    answers = [[int(player(None, jax.random.key(0), None, state, seat, None)) for seat in (0, 1)]
+               for ours in (lanes, plain) for name, player in selfplay.evaluation_opponents(ours, ("scripted",))]
+    assert answers == [[2, 1], [2, 2]]  # seat 1's key 2 is its mirror image's action 1
+
+
 def test_params_change_and_agents_are_saved_as_the_loop_saves_them(run):
     from octax_gym import jax_policy
     from octax_gym.play.agents import load_agent
@@ -217,6 +233,10 @@ def test_turn_based_legal_masks_come_from_the_state_and_are_honoured(take_turns_
                                                                   "selfplay)"),
     (["selfplay", "--game", "Cycles", "--ent-coef-final", "-0.1"], "ent_coef_final must be >= 0, got -0.1"),
     (["pqn", "--game", "Airplane", "--ent-coef-final", "0.001"], "--ent-coef-final: not a setting of pqn"),
+    (["selfplay", "--game", "Duel", "--mirror"], "selfplay: Duel has no mirrored seats (Seats.mirror); mirror is "
+                                                 "for Cycles"),
+    (["ppo", "--game", "Airplane", "--mirror"], "mirror is a setting of selfplay (a two-player game's seats), not of "
+                                                "ppo"),
 ])
 def test_bad_selfplay_flags_are_refused_by_name(flags, message, capsys, tmp_path, monkeypatch):
     from octax_gym.cli import main
