@@ -55,6 +55,49 @@ class Family:
 # One template serves the dodger (a thing landing beside the ship scores, on it costs a life)
 # and the catcher (the reverse): `near` and `far` name the routine each case jumps to.
 
+# The score (three digits, top left), the lives (top right) and the end screen: the same routines in
+# every family, so every variant shows its score and end the same way.
+_SCOREBOARD = r""": draw-score
+	i := bcd-buffer
+	bcd score
+	load v2
+	draw-x := 0
+	draw-y := 0
+	i := hex v0
+	sprite draw-x draw-y 5
+	draw-x += 5
+	i := hex v1
+	sprite draw-x draw-y 5
+	draw-x += 5
+	i := hex digit
+	sprite draw-x draw-y 5
+return
+
+: draw-lives
+	draw-x := 59
+	draw-y := 0
+	i := hex lives
+	sprite draw-x draw-y 5
+return
+
+: game-over
+	clear
+	draw-x := 24
+	draw-y := 13
+	i := bcd-buffer
+	bcd score
+	load v2
+	i := hex v0
+	sprite draw-x draw-y 5
+	draw-x += 6
+	i := hex v1
+	sprite draw-x draw-y 5
+	draw-x += 6
+	i := hex digit
+	sprite draw-x draw-y 5
+	loop again
+"""
+
 _FALLERS = r"""
 ###############################################################################
 # $title: a procedurally generated variant (octax_core.generate, family $family).
@@ -203,46 +246,7 @@ return
 	if obj-x > $x_max then obj-x -= 32
 return
 
-: draw-score
-	i := bcd-buffer
-	bcd score
-	load v2
-	draw-x := 0
-	draw-y := 0
-	i := hex v0
-	sprite draw-x draw-y 5
-	draw-x += 5
-	i := hex v1
-	sprite draw-x draw-y 5
-	draw-x += 5
-	i := hex digit
-	sprite draw-x draw-y 5
-return
-
-: draw-lives
-	draw-x := 59
-	draw-y := 0
-	i := hex lives
-	sprite draw-x draw-y 5
-return
-
-: game-over
-	clear
-	draw-x := 24
-	draw-y := 13
-	i := bcd-buffer
-	bcd score
-	load v2
-	i := hex v0
-	sprite draw-x draw-y 5
-	draw-x += 6
-	i := hex v1
-	sprite draw-x draw-y 5
-	draw-x += 6
-	i := hex digit
-	sprite draw-x draw-y 5
-	loop again
-
+""" + _SCOREBOARD + r"""
 : ship
 	$ship
 : obj-sprite
@@ -436,46 +440,7 @@ return
 	sprite ball-x ball-y $ball_h
 return
 
-: draw-score
-	i := bcd-buffer
-	bcd score
-	load v2
-	draw-x := 0
-	draw-y := 0
-	i := hex v0
-	sprite draw-x draw-y 5
-	draw-x += 5
-	i := hex v1
-	sprite draw-x draw-y 5
-	draw-x += 5
-	i := hex digit
-	sprite draw-x draw-y 5
-return
-
-: draw-lives
-	draw-x := 59
-	draw-y := 0
-	i := hex lives
-	sprite draw-x draw-y 5
-return
-
-: game-over
-	clear
-	draw-x := 24
-	draw-y := 13
-	i := bcd-buffer
-	bcd score
-	load v2
-	i := hex v0
-	sprite draw-x draw-y 5
-	draw-x += 6
-	i := hex v1
-	sprite draw-x draw-y 5
-	draw-x += 6
-	i := hex digit
-	sprite draw-x draw-y 5
-	loop again
-
+""" + _SCOREBOARD + r"""
 : paddle
 	$paddle
 : ball
