@@ -71,6 +71,22 @@ def action_scores(params, obs: jax.Array, num_actions: Optional[int] = None) -> 
     return masked(scores, legal_actions(num_actions)[:scores.shape[-1]])
 
 
+def network_player(greedy: bool, planes: Optional[int] = None):
+    """A network as a player of `octax_core.env.players`' signature (one game, one seat; the
+    params are the player's argument, so one compiled match serves every checkpoint): its
+    scores (`action_scores`) masked to the seat's legal actions, then the largest (greedy) or a
+    sample. `planes`: feed the network the observation's first `planes` planes only (a
+    one-player agent, frames alone, in a two-player seat, whose observation adds the player
+    plane). The self-play trainer's evaluation and `octax-gym evaluate` both play this one."""
+    from octax_gym.train.networks import masked
+
+    def act(params, key, obs, state, seat, legal):
+        scores = action_scores(params, obs[None] if planes is None else obs[None, :planes])[0]
+        scores = masked(scores, jnp.pad(legal, (0, scores.shape[-1] - legal.shape[0])))
+        return jnp.argmax(scores) if greedy else jax.random.categorical(key, scores)
+    return act
+
+
 def sampling_policy(params, seed: int, num_actions: Optional[int] = None) -> Callable[[np.ndarray], np.ndarray]:
     """A batched policy for `collect_dataset`: actions sampled from the softmax of the network's
     scores over the game's `num_actions` actions (the stochastic policy PPO trains and is

@@ -126,14 +126,9 @@ def agent_player(agent: str, env, greedy: bool = True):
 
 
 def _network_player(path: Path, env, greedy: bool):
-    """A saved network as a player of the table's signature: its scores masked to the seat's legal
-    actions, then the largest (greedy) or a sample. A one-player agent (no player plane) is fed
-    the frames alone."""
-    import jax
-    import jax.numpy as jnp
-
-    from octax_gym.jax_policy import action_scores, describe, load_params
-    from octax_gym.train.networks import masked
+    """A saved network as a player (`jax_policy.network_player`), checked against the game's
+    observation and actions. A one-player agent (no player plane) is fed the frames alone."""
+    from octax_gym.jax_policy import describe, load_params, network_player
 
     params = load_params(path)
     network = describe(params)
@@ -143,13 +138,7 @@ def _network_player(path: Path, env, greedy: bool):
                          f"and the player plane), so its agents read {planes} (or {planes - 1}: frames only)")
     if network.num_actions < env.num_actions:
         raise ValueError(f"{path} has {network.num_actions} outputs; {env.spec.id} has {env.num_actions} actions")
-
-    def act(params, key, obs, state, seat, legal):
-        scores = action_scores(params, obs[None, :network.channels])[0]
-        scores = masked(scores, jnp.pad(legal, (0, scores.shape[-1] - legal.shape[0])))
-        return jnp.argmax(scores) if greedy else jax.random.categorical(key, scores)
-
-    return act, params, str(path)
+    return network_player(greedy, network.channels), params, str(path)
 
 
 def format_result(result: dict) -> str:

@@ -65,7 +65,7 @@ def train(config: TrainConfig, out_dir, *, roms: Optional[Sequence] = None, prog
     log_columns = {}
     if config.selfplay:  # matches against the eval_opponents, on the host (selfplay.py)
         opponents = config.eval_opponents
-        evaluate = selfplay.make_evaluate(lanes, trainer.network, config.eval_envs, eval_steps, opponents)
+        evaluate = selfplay.make_evaluate(lanes, config.eval_envs, eval_steps, opponents)
         log_columns = {"eval_columns": selfplay.eval_columns(opponents),
                        "eval_cells": lambda result, i, game: selfplay.evaluation_cells(result, i, opponents)}
     elif config.multitask or config.eval_games:  # each agent plays several rows' games (its own, the eval_games)

@@ -47,7 +47,7 @@ import jax.numpy as jnp
 from octax_core.env import ladder
 from octax_core.env.players import Player, check_player, make_player, player_names
 from octax_gym.train.config import TrainConfig
-from octax_gym.train.networks import ACTIONS, masked
+from octax_gym.jax_policy import network_player
 from octax_gym.train.seats import SEATS, SeatLanes
 
 POLICIES = ("greedy", "sampled")
@@ -108,16 +108,6 @@ def draw_opponent(config: TrainConfig, runner):
     return runner, (past_params, past.reshape(-1))
 
 
-def network_player(network, greedy: bool) -> Player:
-    """The agent as a player of `octax_core.env.players`' signature (one game, one seat): its
-    logits masked to the seat's legal actions, then the largest (greedy) or a sample."""
-    def act(params, key, obs, state, seat, legal):
-        logits = network.apply(params, obs[None])[0][0]
-        logits = masked(logits, jnp.pad(legal, (0, ACTIONS - legal.shape[0])))
-        return jnp.argmax(logits) if greedy else jax.random.categorical(key, logits)
-    return act
-
-
 def evaluation_opponents(lanes: SeatLanes, opponents) -> list[tuple[str, Player]]:
     """(name, player) of each of `opponents` the game has, for the evaluation env: in a mirrored
     one (`--mirror`) the scripted players answer seat 1 in its mirror image (`make_player`'s
@@ -126,7 +116,7 @@ def evaluation_opponents(lanes: SeatLanes, opponents) -> list[tuple[str, Player]
             for name in open_opponents(opponents, lanes.spec)]
 
 
-def make_evaluate(lanes: SeatLanes, network, num_games: int, max_steps: int, opponents) -> Callable:
+def make_evaluate(lanes: SeatLanes, num_games: int, max_steps: int, opponents) -> Callable:
     """`evaluate(params, keys, games) -> [per agent: {(policy, opponent): ladder.MatchResult}]`:
     each agent (`params` stacked along the agent axis, `keys` one per agent) against each of
     `opponents` that the game has, greedy and sampled from the same starts (the same key). One
@@ -136,7 +126,7 @@ def make_evaluate(lanes: SeatLanes, network, num_games: int, max_steps: int, opp
         raise ValueError(f"selfplay: {lanes.spec.id} has none of the eval_opponents {', '.join(opponents)}; its "
                          f"players: {', '.join(player_names(lanes.spec))}")
     opponents, opponent_players = zip(*chosen)
-    players = [network_player(network, True), network_player(network, False), *opponent_players]
+    players = [network_player(True), network_player(False), *opponent_players]
     match = ladder.make_match(lanes.eval_env, lanes.eval_params, num_games, max_steps, players)
 
     def evaluate(params, keys, games) -> list[dict]:
