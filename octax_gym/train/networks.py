@@ -19,11 +19,13 @@ own are masked (`masked`) before sampling, log-probs, entropy and argmax.
 
 from __future__ import annotations
 
+import functools
 import math
 
 import flax.linen as nn
 import jax
 import jax.numpy as jnp
+import numpy as np
 
 HIDDEN = 256
 ACTIONS = 17  # no-op + 16 keys: every game's actions fit (octax_core's games take at most 16 keys)
@@ -45,20 +47,54 @@ def orthogonal(scale: float):
 
 
 def conv_valid(x: jax.Array, kernel: jax.Array, strides: tuple[int, int]) -> jax.Array:
-    """A VALID, NHWC convolution as one matmul over strided slices (im2col), same values as
+    """A VALID, NHWC convolution as its patch matrix times the kernel (im2col), same values as
     `lax.conv_general_dilated`.
 
     Why not `nn.Conv`: on XLA's CPU backend the kernel gradient of a convolution inside a loop
     (our minibatch `lax.scan`) ran 50-130x slower than outside one (measured on this project's
-    layers, jax 0.10), which made a PPO update 40x slower. Slices and a matmul differentiate into
-    pads and matmuls, which run at full speed anywhere.
+    layers, jax 0.10), which made a PPO update 40x slower. A patch matrix and a matmul
+    differentiate into pads and matmuls, which run at full speed anywhere.
     """
     kh, kw, cin, cout = kernel.shape
-    (sh, sw), (h, w) = strides, x.shape[1:3]
+    return patches(x, (kh, kw), tuple(strides)) @ kernel.reshape(kh * kw * cin, cout)
+
+
+@functools.partial(jax.custom_vjp, nondiff_argnums=(1, 2))
+def patches(x: jax.Array, kernel_size: tuple[int, int], strides: tuple[int, int]) -> jax.Array:
+    """(B, H, W, C) -> (B, OH, OW, KH * KW * C): each output position's input patch, kernel row
+    major, then column, then channel (the rows of `kernel.reshape(kh * kw * cin, cout)`).
+
+    Built by one gather with a constant index; its gradient is the transpose of one strided slice
+    per kernel offset (`_sliced_patches`). Both ways give the same bits, forward and backward,
+    but each is the cheaper one in its direction: XLA compiles the 32-way concatenate of the first
+    layer's slices slowly, and runs the gather's own gradient (a scatter-add) slower than the
+    slices' pads (docs/training.md has the measurements).
+    """
+    (kh, kw), (sh, sw), (b, h, w, cin) = kernel_size, strides, x.shape
     oh, ow = (h - kh) // sh + 1, (w - kw) // sw + 1
-    patches = [x[:, i:i + sh * (oh - 1) + 1:sh, j:j + sw * (ow - 1) + 1:sw]
-               for i in range(kh) for j in range(kw)]
-    return jnp.concatenate(patches, axis=-1) @ kernel.reshape(kh * kw * cin, cout)
+    rows = np.arange(oh)[:, None, None, None] * sh + np.arange(kh)[None, None, :, None]
+    cols = np.arange(ow)[None, :, None, None] * sw + np.arange(kw)[None, None, None, :]
+    return x.reshape(b, h * w, cin)[:, (rows * w + cols).reshape(-1)].reshape(b, oh, ow, kh * kw * cin)
+
+
+def _sliced_patches(x: jax.Array, kernel_size: tuple[int, int], strides: tuple[int, int]) -> jax.Array:
+    """`patches` as one strided slice per kernel offset, concatenated."""
+    (kh, kw), (sh, sw), (h, w) = kernel_size, strides, x.shape[1:3]
+    oh, ow = (h - kh) // sh + 1, (w - kw) // sw + 1
+    return jnp.concatenate([x[:, i:i + sh * (oh - 1) + 1:sh, j:j + sw * (ow - 1) + 1:sw]
+                            for i in range(kh) for j in range(kw)], axis=-1)
+
+
+def _patches_forward(x, kernel_size, strides):
+    return patches(x, kernel_size, strides), x.shape  # the backward needs only the shape
+
+
+def _patches_backward(kernel_size, strides, shape, cotangent):
+    _, transpose = jax.vjp(lambda x: _sliced_patches(x, kernel_size, strides), jnp.zeros(shape, cotangent.dtype))
+    return transpose(cotangent)
+
+
+patches.defvjp(_patches_forward, _patches_backward)
 
 
 class Conv(nn.Module):

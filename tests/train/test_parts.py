@@ -12,8 +12,8 @@ import pytest
 
 pytest.importorskip("flax")
 from octax_gym.train import many, ppo, pqn  # noqa: E402
-from octax_gym.train.networks import (ACTIONS, ActorCritic, ConvTorso, QNetwork, conv_valid, legal_actions,  # noqa: E402
-                                      masked, network_for)
+from octax_gym.train.networks import (ACTIONS, ActorCritic, ConvTorso, QNetwork, _sliced_patches, conv_valid,  # noqa: E402
+                                      legal_actions, masked, network_for, patches)
 
 
 def test_network_shapes_and_a_fixed_width():
@@ -36,6 +36,18 @@ def test_conv_valid_equals_lax_conv(x_shape, k_shape, strides):
     kernel = jax.random.normal(jax.random.key(2), k_shape)
     expected = jax.lax.conv_general_dilated(x, kernel, strides, "VALID", dimension_numbers=("NHWC", "HWIO", "NHWC"))
     np.testing.assert_allclose(conv_valid(x, kernel, strides), expected, rtol=1e-4, atol=1e-3)
+
+
+@pytest.mark.parametrize("x_shape, kernel_size, strides", [((3, 64, 32, 4), (8, 4), (4, 2)), ((3, 6, 6, 8), (3, 3), (1, 1))])
+def test_patches_are_the_strided_slices_bit_for_bit_both_ways(x_shape, kernel_size, strides):
+    """The gather (forward) and the slices' transpose (backward) are the strided slices' own bits,
+    so the faster-compiling network trains exactly what the sliced one trained."""
+    x = jax.random.normal(jax.random.key(1), x_shape)
+    sliced = _sliced_patches(x, kernel_size, strides)
+    assert np.array_equal(patches(x, kernel_size, strides), sliced)
+    cotangent = jax.random.normal(jax.random.key(2), sliced.shape)
+    grads = [jax.grad(lambda x, f=f: (f(x, kernel_size, strides) * cotangent).sum())(x) for f in (patches, _sliced_patches)]
+    assert np.array_equal(*grads)
 
 
 def test_masked_actions_are_never_chosen_and_cost_no_entropy():
