@@ -8,7 +8,13 @@ them, so `octax-gym play --agent` and the dataset suite (`octax_gym.datasets.sui
 the trained network. Needs flax (the `train` extra).
 
     params = load_params("runs/ppo/agents/Airplane-seed0.msgpack")
-    net = describe(params)                    # Network(kind="actor_critic", channels=4, num_actions=17)
+    net = describe(params)                    # Network(kind="actor_critic", channels=4, num_actions=17, mirror=False)
+    params, net = load_agent("runs/selfplay/agents/Cycles-seed0.msgpack")   # and how it sees its game
+
+An agent file may also hold a `"view"` record beside `"params"`: how the agent sees its game, which
+its params alone cannot tell. Today that is `{"mirror": True}` for a self-play agent trained with
+`--mirror` (seat 1 sees and plays the mirror image), which must be played in a mirrored env
+(`make_multi(..., mirror=True)`) to play what it learned; `octax-gym evaluate` reads it.
     act = sampling_policy(params, seed=0, num_actions=2)   # numpy (B, 4, 32, 64) -> numpy (B,) actions
 """
 
@@ -23,11 +29,14 @@ import numpy as np
 
 
 class Network(NamedTuple):
-    """What a params file holds: its network, input planes and outputs."""
+    """What an agent file holds: its network, input planes and outputs, and how it sees its game."""
 
     kind: str  # "actor_critic" (PPO, self-play) or "q_network" (PQN)
     channels: int  # input planes: the frames (plus a player plane for self-play agents)
     num_actions: int  # the network's outputs; a game takes its first actions (no-op, then its keys)
+    mirror: bool = False  # trained with mirrored seats (--mirror): play it in a mirrored env
+
+VIEW_KEYS = ("mirror",)  # what an agent file's "view" record may hold
 
 
 def load_params(path) -> dict:
@@ -36,19 +45,36 @@ def load_params(path) -> dict:
     Raises:
         ImportError: flax is missing. ValueError: not params of the package's networks.
     """
+    return load_agent(path)[0]
+
+
+def load_agent(path) -> tuple[dict, Network]:
+    """(params, network) of the agent file at `path`: `load_params`' params, and `describe`'s
+    network with the file's view record (`mirror`) read.
+
+    Raises:
+        ImportError: flax is missing. ValueError: not params of the package's networks, or a view
+            record this version does not know.
+    """
     path = Path(path)
     try:
         import flax.serialization
     except ImportError as exc:
         raise ImportError(f"{path.name} (JAX params) needs flax: pip install 'octax-gym[train]' ({exc})") from exc
     try:
-        params = flax.serialization.msgpack_restore(path.read_bytes())
-        describe(params)
+        saved = flax.serialization.msgpack_restore(path.read_bytes())
+        view = dict(saved.pop("view", {}))
+        network = describe(saved)
     except Exception as exc:  # msgpack's and KeyError's: not a params file of ours
         raise ValueError(f"{path} is not params saved by octax-gym train (flax msgpack of ActorCritic or "
                          f"QNetwork): {exc!r}") from None
-    return jax.tree.map(lambda x: jnp.asarray(x, jnp.float32) if np.asarray(x).dtype == np.float16 else jnp.asarray(x),
-                        params)
+    unknown = sorted(set(view) - set(VIEW_KEYS))
+    if unknown:
+        raise ValueError(f"{path}: its view record holds {unknown}, which this version does not know "
+                         f"(it knows {list(VIEW_KEYS)}); a newer octax-gym saved it")
+    params = jax.tree.map(lambda x: jnp.asarray(x, jnp.float32) if np.asarray(x).dtype == np.float16 else jnp.asarray(x),
+                          saved)
+    return params, network._replace(mirror=bool(view.get("mirror", False)))
 
 
 def describe(params) -> Network:

@@ -24,16 +24,18 @@ import numpy as np
 
 
 def save_agents(out_dir: Path, names: Sequence[str], params, write: bool = True,
-                step: Optional[int] = None) -> list[Path]:
+                step: Optional[int] = None, view: Optional[dict] = None) -> list[Path]:
     """Each agent's slice of `params` (leading agent axis) to `OUT/agents/<name>.msgpack`, and
     with `step` to `<name>-step<step>.msgpack` too; every process takes part (`host_values`),
-    process 0 writes."""
+    process 0 writes. `view` (`jax_policy.VIEW_KEYS`: {"mirror": True} for a --mirror run) is saved
+    beside the params when given, so whoever plays the agent sees its game as it did."""
     params = host_values(params)
     paths = [Path(out_dir) / "agents" / f"{name}.msgpack" for name in names]
     if write:
         paths[0].parent.mkdir(parents=True, exist_ok=True)
         for i, path in enumerate(paths):
-            data = flax.serialization.to_bytes(jax.tree.map(lambda x: x[i], params))
+            agent = jax.tree.map(lambda x: x[i], params)
+            data = flax.serialization.to_bytes({**agent, "view": dict(view)} if view else agent)
             _replace(path, data)
             if step is not None:
                 _replace(path.with_name(f"{names[i]}-step{step}.msgpack"), data)

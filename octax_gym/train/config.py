@@ -131,6 +131,12 @@ class TrainConfig:
         return [f"{game}-seed{seed}" for game in self.game_ids for seed in self.seeds]
 
     @property
+    def agent_view(self) -> dict:
+        """What the saved agents' files record of how they see their game (`jax_policy.VIEW_KEYS`):
+        {"mirror": True} for a --mirror run, else nothing (the files hold their params alone)."""
+        return {"mirror": True} if dict(self.env_overrides).get("mirror", False) else {}
+
+    @property
     def row_agents(self) -> list[int]:
         """For each row of `agents`, the index of the agent that plays it."""
         if self.multitask or self.eval_games:  # with eval_games a ppo or pqn run trains one game (check)
@@ -289,7 +295,7 @@ def resolve_games(games: Union[str, tuple, list]) -> tuple:
         UnknownOptionError: a name that is no registered game (the message lists the valid ones).
         ValueError: an archive that is not there, or an unknown split (`load_archive`'s messages).
     """
-    from octax_gym.game_names import resolve_spec
+    from octax_gym.envs.game_names import resolve_spec
 
     names = [g.strip() for g in games.split(",")] if isinstance(games, str) else list(games)
     out: list = []

@@ -128,7 +128,7 @@ def train(config: TrainConfig, out_dir, *, roms: Optional[Sequence] = None, prog
         rows = log.add(i, i * config.batch_size, time.perf_counter() - start, train_s, result, totals,
                        trainer.host_metrics(i))
         save_agents(out_dir, config.agent_names, runner.params, write=writer,
-                    step=i * config.batch_size if config.save_at_evals else None)
+                    step=i * config.batch_size if config.save_at_evals else None, view=config.agent_view)
         if writer:
             figure.draw(log.rows, config.game_ids, out_dir / "learning_curve.png", title)
         bar.set_postfix(eval=f"{np.mean([r['eval_mean_return'] for r in rows]):.2f}")

@@ -5,49 +5,59 @@ time: why `agent_map="auto"` maps agents one by one on a CPU)."""
 
 from __future__ import annotations
 
+import functools
+
 import jax
 import jax.numpy as jnp
 import numpy as np
 import pytest
 
 pytest.importorskip("flax")
+import flax.serialization  # noqa: E402
 from octax_gym.train import many, ppo, pqn  # noqa: E402
 from octax_gym.train.networks import (ACTIONS, ActorCritic, ConvTorso, QNetwork, _sliced_patches, conv_valid,  # noqa: E402
                                       legal_actions, masked, network_for, patches)
 
 
 def test_network_shapes_and_a_fixed_width():
-    obs = jnp.zeros((5, 4, 32, 64), jnp.uint8)
-    features, _ = ConvTorso().init_with_output(jax.random.key(0), obs)
+    """Shapes only (`jax.eval_shape`): nothing is computed, so nothing compiles."""
+    obs = jax.ShapeDtypeStruct((5, 4, 32, 64), jnp.uint8)
+    key = jax.random.key(0)
+    features, _ = jax.eval_shape(ConvTorso().init_with_output, key, obs)
     assert features.shape == (5, 1024)
-    (logits, value), params = ActorCritic().init_with_output(jax.random.key(0), obs)
+    (logits, value), params = jax.eval_shape(ActorCritic().init_with_output, key, obs)
     assert logits.shape == (5, ACTIONS) == (5, 17) and value.shape == (5,)
     kernels = [params["params"]["ConvTorso_0"][f"Conv_{i}"]["kernel"].shape for i in range(3)]
     assert kernels == [(8, 4, 4, 32), (4, 4, 32, 64), (3, 3, 64, 64)]
-    q_params = QNetwork().init(jax.random.key(0), obs)
+    q_params = jax.eval_shape(QNetwork().init, key, obs)
     assert isinstance(network_for(q_params), QNetwork) and isinstance(network_for(params), ActorCritic)
-    assert network_for(ActorCritic(3).init(jax.random.key(0), obs)).num_actions == 3  # an examples' file
+    assert network_for(jax.eval_shape(ActorCritic(3).init, key, obs)).num_actions == 3  # an examples' file
+
+
+def _normal(shape, seed):
+    return jnp.asarray(np.random.default_rng(seed).normal(size=shape).astype(np.float32))
 
 
 @pytest.mark.parametrize("x_shape, k_shape, strides", [
     ((2, 64, 32, 4), (8, 4, 4, 32), (4, 2)), ((2, 15, 15, 32), (4, 4, 32, 64), (2, 2))])
 def test_conv_valid_equals_lax_conv(x_shape, k_shape, strides):
-    x = jax.random.normal(jax.random.key(1), x_shape)
-    kernel = jax.random.normal(jax.random.key(2), k_shape)
-    expected = jax.lax.conv_general_dilated(x, kernel, strides, "VALID", dimension_numbers=("NHWC", "HWIO", "NHWC"))
-    np.testing.assert_allclose(conv_valid(x, kernel, strides), expected, rtol=1e-4, atol=1e-3)
+    both = jax.jit(lambda x, kernel: (conv_valid(x, kernel, strides), jax.lax.conv_general_dilated(
+        x, kernel, strides, "VALID", dimension_numbers=("NHWC", "HWIO", "NHWC"))))
+    ours, expected = both(_normal(x_shape, 1), _normal(k_shape, 2))
+    np.testing.assert_allclose(ours, expected, rtol=1e-4, atol=1e-3)
 
 
 @pytest.mark.parametrize("x_shape, kernel_size, strides", [((3, 64, 32, 4), (8, 4), (4, 2)), ((3, 6, 6, 8), (3, 3), (1, 1))])
 def test_patches_are_the_strided_slices_bit_for_bit_both_ways(x_shape, kernel_size, strides):
     """The gather (forward) and the slices' transpose (backward) are the strided slices' own bits,
     so the faster-compiling network trains exactly what the sliced one trained."""
-    x = jax.random.normal(jax.random.key(1), x_shape)
-    sliced = _sliced_patches(x, kernel_size, strides)
-    assert np.array_equal(patches(x, kernel_size, strides), sliced)
-    cotangent = jax.random.normal(jax.random.key(2), sliced.shape)
-    grads = [jax.grad(lambda x, f=f: (f(x, kernel_size, strides) * cotangent).sum())(x) for f in (patches, _sliced_patches)]
-    assert np.array_equal(*grads)
+    def forward_and_backward(f, x, cotangent):
+        out, transpose = jax.vjp(lambda x: f(x, kernel_size, strides), x)
+        return out, transpose(cotangent)[0]
+    x = _normal(x_shape, 1)
+    cotangent = _normal(jax.eval_shape(lambda x: _sliced_patches(x, kernel_size, strides), x).shape, 2)
+    ours, sliced = (jax.jit(functools.partial(forward_and_backward, f))(x, cotangent) for f in (patches, _sliced_patches))
+    assert np.array_equal(ours[0], sliced[0]) and np.array_equal(ours[1], sliced[1])
 
 
 def test_masked_actions_are_never_chosen_and_cost_no_entropy():
@@ -105,9 +115,9 @@ def _bits_of_agent(fn, params, obs, agent_map):
 
 def test_agent_map_one_by_one_is_bit_exact_where_vmap_is_not():
     network = QNetwork()
-    obs = (jax.random.uniform(jax.random.key(0), (4, 8, 4, 32, 64)) < 0.2).astype(jnp.uint8)  # 4 agents x 8 frames
-    params = jax.tree.map(lambda *x: jnp.stack(x), *[network.init(k, obs[0, :1]) for k in jax.random.split(
-        jax.random.key(1), 4)])
+    obs = jnp.asarray(np.random.default_rng(0).random((4, 8, 4, 32, 64)) < 0.2, jnp.uint8)  # 4 agents x 8 frames
+    init = jax.jit(network.init)
+    params = jax.tree.map(lambda *x: np.stack(x), *[init(jax.random.key(k), obs[0, :1]) for k in range(4)])
 
     def grad(p, o):
         return jax.grad(lambda p: jax.nn.log_softmax(network.apply(p, o)).mean())(p)
@@ -183,3 +193,28 @@ def test_learn_passes_over_the_whole_rollout_each_epoch_and_counts_the_update():
     # twice the lanes (self-play's two seats): the same minibatch count, each twice as large
     _, stats = jax.jit(rollout.make_learn(config, optimizer, loss))(runner, jnp.arange(24.0).reshape(4, 6))
     assert float(stats["size"]) == 8 and float(stats["mean"]) == pytest.approx(11.5)
+
+
+def test_an_agent_file_records_how_its_agent_sees_the_game(tmp_path):
+    """A --mirror run's agents carry {"mirror": True} beside their params (`TrainConfig.agent_view`),
+    read back by `jax_policy.load_agent`; a plain run's files hold their params alone, as before."""
+    from octax_gym import jax_policy
+    from octax_gym.train import TrainConfig
+    from octax_gym.train.checkpoints import save_agents
+
+    shapes = jax.eval_shape(ActorCritic().init, jax.random.key(0), jax.ShapeDtypeStruct((1, 5, 32, 64), jnp.uint8))
+    rng = np.random.default_rng(0)
+    params = jax.tree.map(lambda s: rng.normal(size=s.shape).astype(np.float32), shapes)
+    stacked = jax.tree.map(lambda x: x[None], params)
+    mirrored = TrainConfig(algorithm="selfplay", games=("Cycles",), env_overrides=(("mirror", True),))
+    assert mirrored.agent_view == {"mirror": True} and TrainConfig(games=("Cycles",)).agent_view == {}
+    [plain] = save_agents(tmp_path / "plain", ["a"], stacked, view=TrainConfig(games=("Cycles",)).agent_view)
+    [seen] = save_agents(tmp_path / "mirror", ["a"], stacked, view=mirrored.agent_view)
+    assert plain.read_bytes() == flax.serialization.to_bytes(jax.tree.map(lambda x: x[0], stacked))  # as of old
+    for path, mirror in ((plain, False), (seen, True)):
+        loaded, network = jax_policy.load_agent(path)
+        assert network == ("actor_critic", 5, ACTIONS, mirror) and jax_policy.load_params(path).keys() == {"params"}
+        assert all(np.array_equal(a, b) for a, b in zip(jax.tree.leaves(loaded), jax.tree.leaves(params)))
+    [unknown] = save_agents(tmp_path / "new", ["a"], stacked, view={"layout": "columns"})
+    with pytest.raises(ValueError, match=r"holds \['layout'\], which this version does not know \(it knows \['mirror'\]\)"):
+        jax_policy.load_agent(unknown)
