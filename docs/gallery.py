@@ -147,7 +147,7 @@ def measure(game_id: str) -> dict:
     import numpy as np
 
     import octax_core
-    from octax_gym import render
+    from octax_gym.envs import render
 
     spec = octax_core.get_spec(game_id)
     env, params = octax_core.make(game_id, autoreset=True)

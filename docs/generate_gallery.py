@@ -29,7 +29,7 @@ def main(argv=None) -> int:
 
     import octax_core
     from octax_core.emulator.state import screen_pixels
-    from octax_gym import render
+    from octax_gym.envs import render
     from octax_gym.generated import load_archive
 
     per_archive = [load_archive(folder) for folder in args.archives]

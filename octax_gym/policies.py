@@ -21,7 +21,7 @@ import jax.numpy as jnp
 import numpy as np
 
 from octax_core.env import players
-from octax_gym.choices import check_choice
+from octax_gym.envs.choices import check_choice
 
 Policy = Union[None, str, Callable[[Any], Any]]
 Act = Callable[[Any], Any]  # the batched observation -> one action per env

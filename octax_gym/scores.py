@@ -32,7 +32,7 @@ from typing import Callable, Optional, Sequence
 import numpy as np
 from scipy import stats
 
-from octax_gym.choices import UnknownOptionError
+from octax_gym.envs.choices import UnknownOptionError
 
 REFERENCE_SOURCES = ("search", "scripted", "trained")  # where a reference may come from (docs/scores.md)
 Statistic = Callable[[np.ndarray], float]

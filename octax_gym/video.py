@@ -27,8 +27,8 @@ import numpy as np
 from tqdm import tqdm
 
 from octax_core.validate import check_int
-from octax_gym import render
-from octax_gym.game_names import resolve_env_id
+from octax_gym.envs import render
+from octax_gym.envs.game_names import resolve_env_id
 from octax_gym.policies import Act, Policy, check_policy, make_policy
 
 VIDEO_EXTRA_HINT = "pip install 'octax-gym[video]'"

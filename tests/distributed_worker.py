@@ -36,7 +36,7 @@ def main(out, coordinator, num_processes, rank):
     import octax_gym
     gym.register_envs(octax_gym)
     import jax
-    from octax_gym.backends import resolve_device
+    from octax_gym.step.backends import resolve_device
     local = jax.local_devices()
     # a device named as JAX prints it ("cpu:2048" on process 1) or by its place here ("cpu") is this process's
     named = [resolve_device(f"{d.platform}:{d.id}") == d for d in local] + [resolve_device("cpu") == local[0]]

@@ -59,8 +59,8 @@ def game_or_rom(name: str) -> tuple:
         ValueError: the file is empty or too big to be a program.
     """
     from octax_core.tools.trace import raw_rom_spec
-    from octax_gym.choices import UnknownOptionError
-    from octax_gym.game_names import resolve_spec
+    from octax_gym.envs.choices import UnknownOptionError
+    from octax_gym.envs.game_names import resolve_spec
 
     try:
         return resolve_spec(name), None

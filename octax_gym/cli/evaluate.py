@@ -16,7 +16,12 @@ Greedy is the default because a sampled policy keeps its exploration: issue 41 m
 self-play policy at 1.06 nats of entropy on Cycles, about a quarter of its moves random, and at
 10% random moves even the scripted Cycles player wins none of 32 games against itself.
 
-`--json` prints one object: {"game", "agent", "policy", "episodes", "max_steps", "rungs": [{"opponent",
+An agent trained with mirrored seats (`octax-gym train selfplay --mirror`: its file says so, see
+`octax_gym.jax_policy`) is played in the mirrored env it trained in, so from seat 1 it sees the
+mirror image; the table's players there answer in the mirror image too, which for them is the
+same game.
+
+`--json` prints one object: {"game", "agent", "policy", "mirror", "episodes", "max_steps", "rungs": [{"opponent",
 "win", "draw", "loss", "margin", "ended", "episodes", "by_seat"}, ...], "elo", "ladder": {rung: Elo}}; win,
 draw and loss are fractions of the episodes, margin the mean of the agent's return minus the
 opponent's, by_seat the same four from each seat (a game whose seats differ, Paddles, shows which
@@ -87,26 +92,40 @@ def evaluate(game: Any, agent: str, *, opponents: str = LADDER, episodes: int = 
     from octax_core.env.ladder import play_ladder
     from octax_core.env.multi import make_multi
     from octax_core.validate import check_int
-    from octax_gym.game_names import resolve_spec
+    from octax_gym.envs.game_names import resolve_spec
 
     spec = resolve_spec(game, players=2)
     episodes = check_int("--episodes", episodes, 2)
     if episodes % 2:
         raise ValueError(f"--episodes must be even (half the games from each seat), got {episodes}")
-    env, params = make_multi(spec, rom=rom)
+    saved = _saved_agent(agent)
+    # An agent trained with --mirror sees seat 1 as the mirror image: it plays in a mirrored env,
+    # where the ladder's scripted rungs answer in the mirror image too (the same game for them).
+    mirror = saved is not None and saved[1].mirror
+    env, params = make_multi(spec, rom=rom, mirror=mirror)
     if max_steps is None:
         max_steps = int(params.max_episode_steps)
     max_steps = check_int("--max-steps", max_steps, 1)
     names = None if opponents == LADDER else [name.strip() for name in str(opponents).split(",")]
-    player, agent_params, label = agent_player(agent, env, greedy=not sampled)
+    player, agent_params, label = agent_player(agent, env, greedy=not sampled, saved=saved)
     table = play_ladder(env, params, player, agent_params, jax.random.key(seed), num_games=episodes,
                         max_steps=max_steps, opponents=names, rate=names is None)
-    return {"game": spec.id, "agent": label, "policy": "sampled" if sampled else "greedy", "episodes": episodes,
-            "max_steps": max_steps, **table}
+    return {"game": spec.id, "agent": label, "policy": "sampled" if sampled else "greedy", "mirror": mirror,
+            "episodes": episodes, "max_steps": max_steps, **table}
 
 
-def agent_player(agent: str, env, greedy: bool = True):
-    """(player, params, label) of `--agent`: a table player (params None) or a saved network.
+def _saved_agent(agent: str):
+    """(params, jax_policy.Network) of an agent file, or None for a player name."""
+    if not Path(agent).is_file():
+        return None
+    from octax_gym.jax_policy import load_agent
+
+    return load_agent(agent)
+
+
+def agent_player(agent: str, env, greedy: bool = True, saved=None):
+    """(player, params, label) of `--agent`: a table player (params None) or a saved network
+    (`saved`: its `jax_policy.load_agent`, when already read).
 
     Raises:
         ValueError: neither a file nor a player name (the message names both kinds), or a network
@@ -116,7 +135,7 @@ def agent_player(agent: str, env, greedy: bool = True):
 
     path = Path(agent)
     if path.is_file():
-        return _network_player(path, env, greedy)
+        return _network_player(path, env, greedy, saved)
     try:
         name = check_player(agent, env.spec)
     except ValueError as exc:
@@ -125,13 +144,15 @@ def agent_player(agent: str, env, greedy: bool = True):
     return make_player(name, env.spec, env.mirrored), None, name
 
 
-def _network_player(path: Path, env, greedy: bool):
+def _network_player(path: Path, env, greedy: bool, saved=None):
     """A saved network as a player (`jax_policy.network_player`), checked against the game's
     observation and actions. A one-player agent (no player plane) is fed the frames alone."""
-    from octax_gym.jax_policy import describe, load_params, network_player
+    from octax_gym.jax_policy import load_agent, network_player
 
-    params = load_params(path)
-    network = describe(params)
+    params, network = saved if saved is not None else load_agent(path)
+    if network.mirror and not env.mirrored:
+        raise ValueError(f"{path} was trained with mirrored seats (--mirror): play it in a mirrored env "
+                         f"(make_multi({env.spec.id!r}, mirror=True)), where seat 1 sees what it saw")
     planes = env.observation_shape[0]  # the frames and the player plane
     if network.channels not in (planes, planes - 1):
         raise ValueError(f"{path} reads {network.channels} planes; {env.spec.id}'s seats see {planes} (the frames "
@@ -143,8 +164,9 @@ def _network_player(path: Path, env, greedy: bool):
 
 def format_result(result: dict) -> str:
     """The table `octax-gym evaluate` prints without --json."""
+    seats = "mirrored seats: seat 1 sees the mirror image, " if result.get("mirror") else ""
     lines = [f"{result['game']}: {result['agent']} ({result['policy']}), {result['episodes']} episodes per "
-             f"opponent (half from each seat), at most {result['max_steps']} steps each"]
+             f"opponent ({seats}half from each seat), at most {result['max_steps']} steps each"]
     header = ("opponent", "win", "draw", "loss", "margin", "from seat 0 / 1", "ended")
     rows = [header] + [(row["opponent"], f"{row['win']:.2f}", f"{row['draw']:.2f}", f"{row['loss']:.2f}",
                         f"{row['margin']:+.2f}", " / ".join(f"{seat['margin']:+.2f}" for seat in row["by_seat"]),

@@ -36,9 +36,9 @@ def add_commands(commands: argparse._SubParsersAction) -> None:
 def _cmd_list(args: argparse.Namespace) -> int:
     from octax_core.env import romstore
     from octax_core.env.games import CATEGORIES, SUITES, get_spec, list_games
-    from octax_gym.choices import UnknownOptionError
+    from octax_gym.envs.choices import UnknownOptionError
     from octax_gym.cli.common import print_table
-    from octax_gym.game_names import env_id
+    from octax_gym.envs.game_names import env_id
 
     problem = None
     if args.suite is not None and args.suite not in SUITES:
@@ -74,7 +74,7 @@ def _cmd_info(args: argparse.Namespace) -> int:
     from octax_core.emulator.platforms import resolve_platform
     from octax_core.emulator.state import screen_values_max, screen_values_shape
     from octax_core.emulator.quirks import resolve_quirks
-    from octax_gym import game_names
+    from octax_gym.envs import game_names
 
     spec, rom = game_or_rom(args.game)  # an unknown name: UnknownOptionError, exit status 1
     config = make_config(spec)[0]  # what gym.make / make_vec use by default (the game's own speed and timers)

@@ -58,7 +58,7 @@ def add_commands(commands: argparse._SubParsersAction) -> None:
 
 def _check_port_and_seed(args: argparse.Namespace) -> None:
     """Refuses, before anything is compiled, a port the socket and a seed the env would refuse later."""
-    from octax_gym.compiled_step import MAX_SEED
+    from octax_gym.step.compiled_step import MAX_SEED
 
     if not 0 <= args.port <= 65535:
         raise ValueError(f"--port must be in 0..65535 (0: a free port), got {args.port}")
@@ -100,7 +100,7 @@ def _cmd_play(args: argparse.Namespace) -> int:
             raise ValueError("--record stores one-player games (the human's episodes of a one-player env); "
                              f"{spec.id} is a two-player game")
         from octax_gym.play.record import Recorder
-        from octax_gym.vector import OctaxVectorEnv
+        from octax_gym.envs.vector import OctaxVectorEnv
         probe = OctaxVectorEnv(spec.id, 1, **env_options)
         recorder = Recorder(spec.id, args.record, observation_space=probe.single_observation_space,
                             num_actions=num_actions, recorder=args.recorder, overwrite=args.overwrite,

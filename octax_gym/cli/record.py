@@ -45,7 +45,7 @@ def add_commands(commands: argparse._SubParsersAction) -> None:
 
 def _cmd_record(args: argparse.Namespace) -> int:
     from octax_gym import video
-    from octax_gym.registration import register_game
+    from octax_gym.envs.registration import register_game
 
     env_kwargs = {name: value for name, value in (("render_scale", args.scale), ("palette", args.palette))
                   if value is not None}

@@ -179,11 +179,11 @@ def config_from_args(args: argparse.Namespace):
 def _cmd_train(args: argparse.Namespace) -> int:
     distributed = (args.coordinator, args.num_processes, args.process_id)
     if any(value is not None for value in distributed):  # before anything computes with JAX
-        import octax_gym.distributed
+        import octax_gym.step.distributed
 
         try:
-            octax_gym.distributed.initialize(*distributed)
-        except octax_gym.distributed.DistributedInitError as exc:  # a start-up mistake, named: no traceback
+            octax_gym.step.distributed.initialize(*distributed)
+        except octax_gym.step.distributed.DistributedInitError as exc:  # a start-up mistake, named: no traceback
             raise ValueError(str(exc)) from None
     if args.resume is not None:
         config, out_dir = _resumed(args)

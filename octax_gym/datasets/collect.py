@@ -6,7 +6,7 @@
 
 Minari's own `DataCollector` wraps one env and steps it alone. Here all `num_envs` lanes step in
 one jitted call, the compiled env step behind `OctaxEnv` and `OctaxVectorEnv`
-(`octax_gym.compiled_step`), and each lane's episode is gathered on the host until it ends. A lane
+(`octax_gym.step.compiled_step`), and each lane's episode is gathered on the host until it ends. A lane
 whose episode ends is reset in the same call with the next unused seed, so every episode, not
 just each lane's first, starts the way `OctaxEnv.reset(seed=s)` starts: from the key chain of
 its own seed s. `dataset.recover_environment()`, reset with an episode's seed (`episode_seed`)
@@ -35,14 +35,14 @@ from gymnasium.vector import AutoresetMode
 from tqdm import tqdm
 
 from octax_core.validate import check_int
-from octax_gym import action_check, compiled_step
-from octax_gym.choices import check_names
-from octax_gym.compiled_step import GYM_ENV_OPTIONS, MAX_SEED
-from octax_gym.game_names import resolve_env_id
 from octax_gym.datasets.diskwrite import DatasetWriteError
 from octax_gym.datasets.storage import (DatasetWriter, EpisodeRecord, check_dataset_id, import_minari,
                                         kept_episodes)
+from octax_gym.envs.choices import check_names
+from octax_gym.envs.game_names import resolve_env_id
 from octax_gym.policies import Act, Policy, check_policy, make_policy, policy_name
+from octax_gym.step import action_check, compiled_step
+from octax_gym.step.compiled_step import GYM_ENV_OPTIONS, MAX_SEED
 
 # Finished episodes are written once they hold this many steps: ~160 MB of 32 x 64 frames (CHIP-8),
 # 4x that of 64 x 128 ones (SUPER-CHIP, XO-CHIP).
@@ -104,7 +104,7 @@ def collect_dataset(env_id: str, dataset_id: str, num_steps: int, *, num_envs: i
             70x smaller; read back bit for bit by any HDF5 reader, `minari.load_dataset` included:
             `octax_gym.datasets.storage`); False stores them plain.
         extra_metadata: more keys for the dataset's metadata.json (JSON values), e.g. a policy card.
-        **env_options: the env's options (`octax_gym.compiled_step.GYM_ENV_OPTIONS`: max_episode_steps,
+        **env_options: the env's options (`octax_gym.step.compiled_step.GYM_ENV_OPTIONS`: max_episode_steps,
             frames_per_step, noop_max, repeat_action_probability, ...); they are stored in the
             dataset's env spec, so `recover_environment()` builds the same env.
 
@@ -173,7 +173,7 @@ def recovery_spec(gym_id: str, env_options: dict) -> gymnasium.envs.registration
 
     A `max_episode_steps` option goes into the kwargs, the env's own truncation (what `make_vec`
     builds with too), and into the spec's field, which `env.spec.max_episode_steps` shows and
-    whose `TimeLimit` ends episodes at the same step (`octax_gym.registration`).
+    whose `TimeLimit` ends episodes at the same step (`octax_gym.envs.registration`).
     """
     spec = gymnasium.spec(gym_id)
     kwargs = {**spec.kwargs, **env_options}
@@ -223,7 +223,7 @@ def _collect(lanes: "_Lanes", act: Act, num_steps: int, seed: int,
 
 class _Lanes:
     """`num_envs` lanes of one game driven by the compiled env step behind `OctaxEnv` and
-    `OctaxVectorEnv` (`octax_gym.compiled_step`), with the envs' key derivation, in one jitted
+    `OctaxVectorEnv` (`octax_gym.step.compiled_step`), with the envs' key derivation, in one jitted
     call per step: the batched step, then a reset of each lane whose episode just ended.
 
     Seeds flow as in the envs: a lane reset with seed s starts its key chain at

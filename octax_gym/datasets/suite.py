@@ -35,7 +35,7 @@ import shutil
 from pathlib import Path
 from typing import Optional, Sequence
 
-from octax_gym.choices import UnknownOptionError
+from octax_gym.envs.choices import UnknownOptionError
 
 # Games where the package's PPO learns on two CPU cores (docs/results.md).
 GAMES = ("Airplane", "Deep8", "Dodge", "Filter", "Flak", "Squash")

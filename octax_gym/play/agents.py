@@ -7,7 +7,7 @@ Two formats:
   older examples' files too), run by `octax_gym.jax_policy` with the package's network; it plays
   greedily (the largest logit or Q-value among the game's actions). Needs flax (the `train` extra).
 * `*.zip`: a Stable-Baselines3 model (`model.save(...)`: PPO, A2C or DQN over
-  `octax_gym.sb3.OctaxCNNExtractor`), played with `policy.predict(obs, deterministic=True)` as the
+  `octax_gym.integrations.sb3.OctaxCNNExtractor`), played with `policy.predict(obs, deterministic=True)` as the
   model's own `predict`. SB3's loader unpickles the zip, which runs any code stored in it, so the
   policy is rebuilt from the zip's JSON and tensors alone (`octax_gym.play.sb3_zip`); other zips
   are refused unless `trust=True` (`--trust-agent`) hands them to SB3's loader. Needs the `sb3` extra.

@@ -22,7 +22,7 @@ from gymnasium import spaces
 
 from octax_gym import datasets
 from octax_gym.datasets import storage
-from octax_gym.game_names import resolve_env_id
+from octax_gym.envs.game_names import resolve_env_id
 
 
 class Recorder:

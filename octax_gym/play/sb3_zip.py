@@ -10,7 +10,7 @@ file handed to `octax-gym play --agent` may come from anyone, so here:
 * `policy.pth` is read by `torch.load(weights_only=True)`, which builds tensors and plain
   containers only;
 * the policy is rebuilt from the architectures this project trains (SB3's actor-critic policy of
-  PPO and A2C, or DQN's Q-network, over `octax_gym.sb3.OctaxCNNExtractor`), the layer sizes taken
+  PPO and A2C, or DQN's Q-network, over `octax_gym.integrations.sb3.OctaxCNNExtractor`), the layer sizes taken
   from the weights' shapes, and the weights loaded strictly (every name and shape must match).
 
 Anything else cannot be rebuilt without running code from the file and is refused with an
@@ -31,7 +31,7 @@ import torch
 from stable_baselines3.common.policies import ActorCriticPolicy, BasePolicy
 from stable_baselines3.dqn.policies import DQNPolicy
 
-from octax_gym.sb3 import OctaxCNNExtractor
+from octax_gym.integrations.sb3 import OctaxCNNExtractor
 
 # The policy classes' modules, as SB3 writes `policy_class.__module__` in `data`: which family.
 POLICY_MODULES = {"stable_baselines3.common.policies": "actor-critic (PPO, A2C)",
@@ -157,7 +157,7 @@ def _policy_kwargs(entry: Any, family: str) -> dict:
 
 
 def _channels(entry: Any) -> int:
-    """The frames of the observation space SB3 saw: uint8 0..255 (frames, 32, 64), octax_gym.sb3's."""
+    """The frames of the observation space SB3 saw: uint8 0..255 (frames, 32, 64), octax_gym.integrations.sb3's."""
     fields = _readable(entry, "observation_space")
     shape, dtype = fields.get("_shape"), fields.get("dtype")
     # low and high are written as numpy's summarised text ("[[[0 0 0 ... 0 0 0] ..."): every number shown must match

@@ -33,10 +33,10 @@ from typing import Optional
 
 from aiohttp import WSMsgType, web
 
+from octax_gym.envs.vector import FRAMES_PER_SECOND
 from octax_gym.play import hosts, protocol
 from octax_gym.play.connections import MAX_CONNECTIONS, REQUEST_TIMEOUT, ConnectionGuard, GuardedRunner
 from octax_gym.play.session import Session
-from octax_gym.vector import FRAMES_PER_SECOND
 
 log = logging.getLogger("octax_gym.play")
 STATIC = Path(__file__).parent / "static"

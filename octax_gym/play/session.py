@@ -25,12 +25,12 @@ import numpy as np
 
 from octax_core.env.games import list_games
 from octax_core.env.players import make_player
-from octax_gym import render
-from octax_gym.compiled_step import MAX_SEED
-from octax_gym.game_names import resolve_spec
-from octax_gym.multi_vector import MultiAgentVectorEnv
+from octax_gym.envs import render
+from octax_gym.envs.game_names import resolve_spec
+from octax_gym.envs.multi_vector import MultiAgentVectorEnv
+from octax_gym.envs.vector import FRAMES_PER_SECOND, OctaxVectorEnv
 from octax_gym.play.protocol import TABLE_PLAYERS
-from octax_gym.vector import FRAMES_PER_SECOND, OctaxVectorEnv
+from octax_gym.step.compiled_step import MAX_SEED
 
 # Octo's keyboard layout: the keys of a 4x4 block on a QWERTY keyboard, row by row, are the
 # COSMAC VIP's hex keypad 1 2 3 C / 4 5 6 D / 7 8 9 E / A 0 B F.

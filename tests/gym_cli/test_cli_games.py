@@ -11,7 +11,8 @@ import pytest
 from octax_core.env import environment as core_env
 from octax_core.env import romstore
 from octax_core.env.games import CATEGORIES, get_spec, list_games
-from octax_gym import cli, env_id, game_names
+from octax_gym import cli, env_id
+from octax_gym.envs import game_names
 
 
 @pytest.fixture

@@ -102,7 +102,7 @@ def test_recorded_human_episodes_replay(tmp_path, monkeypatch):
     pytest.importorskip("minari", reason="recording needs the datasets extra")
     from octax_gym.datasets import episode_seed
     from octax_gym.play.record import Recorder
-    from octax_gym.vector import OctaxVectorEnv
+    from octax_gym.envs.vector import OctaxVectorEnv
 
     monkeypatch.setenv("MINARI_DATASETS_PATH", str(tmp_path))
     probe = OctaxVectorEnv(GAME, 1)

@@ -76,7 +76,7 @@ def recorded(tmp_path_factory):
     from octax_gym.play.record import Recorder
     from octax_gym.play.server import start_in_thread
     from octax_gym.play.session import Session
-    from octax_gym.vector import OctaxVectorEnv
+    from octax_gym.envs.vector import OctaxVectorEnv
 
     before = os.environ.get("MINARI_DATASETS_PATH")
     os.environ["MINARI_DATASETS_PATH"] = str(tmp_path_factory.mktemp("minari"))
@@ -129,7 +129,7 @@ def episode_steps(log: list[dict], episode: int) -> list[dict]:
 
 def replay_frames(game: str, seed: int, actions: list) -> list[np.ndarray]:
     """The env alone, reset with `seed` and stepped with `actions`: each step's frames."""
-    from octax_gym.vector import OctaxVectorEnv
+    from octax_gym.envs.vector import OctaxVectorEnv
 
     env = OctaxVectorEnv(game, 1, autoreset_mode="disabled")
     obs, _ = env.reset(seed=seed)

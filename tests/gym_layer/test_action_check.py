@@ -22,8 +22,8 @@ from jax._src.array import ArrayImpl  # the one class behind jax.Array; its _val
 import octax_gym
 from counter_game import COUNTER
 from octax_gym import OctaxVectorEnv
-from octax_gym.action_check import (MAX_PENDING, DeferredCheck, InvalidActionError, accumulate, check_batch, to_device,
-                                    to_int)
+from octax_gym.step.action_check import (MAX_PENDING, DeferredCheck, InvalidActionError, accumulate, check_batch,
+                                         to_device, to_int)
 
 
 def _no_waiting_reads(monkeypatch):
@@ -86,7 +86,7 @@ def test_accelerator_torch_actions_are_never_read_on_the_step_path(make_envs, mo
     def read(*args, **kwargs):
         raise AssertionError("the step path read a torch action on the host")
     with monkeypatch.context() as patch, jax.transfer_guard_device_to_host("disallow"):
-        patch.setattr("octax_gym.action_check._in_host_memory", lambda tensor: False)
+        patch.setattr("octax_gym.step.action_check._in_host_memory", lambda tensor: False)
         _no_waiting_reads(patch)
         for name in ("item", "tolist", "numpy", "__int__", "__index__", "__bool__", "__array__", "min", "max"):
             patch.setattr(torch.Tensor, name, read)
@@ -194,7 +194,8 @@ def test_out_of_range_is_one_error_type_on_the_host_and_the_device():
 
 
 def test_the_envs_check_actions_only_through_this_module(counter_rom, monkeypatch):
-    from octax_gym import OctaxEnv, action_check
+    from octax_gym import OctaxEnv
+    from octax_gym.step import action_check
 
     calls = []
     for name in ("to_device", "to_int"):
@@ -215,7 +216,7 @@ def test_no_other_module_of_the_user_layer_words_an_action_check():
     wording = ("is out of range", "actions must", "an action is one integer")
     modules = sorted(path.relative_to(package).as_posix() for path in package.rglob("*.py")
                      if any(words in path.read_text() for words in wording))
-    assert modules == ["action_check.py"]
+    assert modules == ["step/action_check.py"]
 
 
 # --- values beyond int32: the range is checked before any narrowing, in every backend and view ---
@@ -346,7 +347,7 @@ def test_the_first_bad_step_s_value_is_named_after_clean_ones(make_envs, monkeyp
     """Several steps pending: the error names the first bad action as given, not a later one's
     (accelerator tensors, stood in for as above, are checked on the device)."""
     torch = pytest.importorskip("torch", reason="the torch extra is installed by `make test`")
-    monkeypatch.setattr("octax_gym.action_check._in_host_memory", lambda tensor: False)
+    monkeypatch.setattr("octax_gym.step.action_check._in_host_memory", lambda tensor: False)
     envs = make_envs("jax")
     envs.reset(seed=0)
     message = rf"action {2**40} is out of range; valid actions are 0\.\.2 \(env 1, "

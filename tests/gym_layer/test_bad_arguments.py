@@ -10,7 +10,7 @@ import pytest
 import octax_gym  # noqa: F401
 from counter_game import COUNTER
 from octax_gym import InvalidActionError, OctaxEnv, OctaxVectorEnv
-from octax_gym.choices import UnknownOptionError
+from octax_gym.envs.choices import UnknownOptionError
 
 
 @pytest.fixture(scope="module")

@@ -1,4 +1,4 @@
-"""One error type for an unknown name (octax_gym/choices.py), raised by every place that takes one.
+"""One error type for an unknown name (octax_gym/envs/choices.py), raised by every place that takes one.
 
 The error's own wording is checked first; then every unknown-name path of the user layer, each
 raising `UnknownOptionError` with the bad value and the valid choices. Most paths fail before an
@@ -13,8 +13,9 @@ import pytest
 
 import octax_gym
 from counter_game import COUNTER
-from octax_gym import OctaxEnv, OctaxVectorEnv, UnknownOptionError, render, scores, video
-from octax_gym.choices import check_choice, check_names
+from octax_gym import OctaxEnv, OctaxVectorEnv, UnknownOptionError, scores, video
+from octax_gym.envs import render
+from octax_gym.envs.choices import check_choice, check_names
 
 
 def test_the_message_names_the_value_the_close_matches_and_every_choice():

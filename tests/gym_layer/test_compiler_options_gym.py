@@ -11,8 +11,8 @@ import jax.numpy as jnp
 from gymnasium.vector import AutoresetMode
 
 import octax_core
-from octax_gym import action_check
-from octax_gym.compiled_step import CompiledStep
+from octax_gym.step import action_check
+from octax_gym.step.compiled_step import CompiledStep
 
 NUM_ENVS = 3
 

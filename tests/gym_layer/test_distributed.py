@@ -1,5 +1,5 @@
-"""A vector env sharded over devices and processes (octax_gym/sharding.py, `devices=`), with JAX's
-distributed runtime (octax_gym/distributed.py): real processes on 127.0.0.1 with CPU collectives
+"""A vector env sharded over devices and processes (octax_gym/step/sharding.py, `devices=`), with JAX's
+distributed runtime (octax_gym/step/distributed.py): real processes on 127.0.0.1 with CPU collectives
 (Gloo), each stepping only its lanes, and every lane equal to the same global env of a plain
 single-device env. Every subprocess runs under a timeout, so nothing here can hang.
 """
@@ -21,7 +21,7 @@ from jax.sharding import Mesh
 
 import gymnasium as gym
 import octax_gym
-from octax_gym import sharding
+from octax_gym.step import sharding
 
 REPO = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(REPO / "tests"))
@@ -172,7 +172,7 @@ def test_process_0_alone_is_refused_after_the_timeout():
 
 def test_where_jax_still_aborts_the_line_before_it_names_the_cause():
     address = f"127.0.0.1:{free_port()}"  # process 1 shakes hands, then stops before JAX's registration
-    stops = run(["-c", f"from octax_gym import handshake\nprint('MEETING', flush=True)\n"
+    stops = run(["-c", f"from octax_gym.step import handshake\nprint('MEETING', flush=True)\n"
                        f"handshake.meet({address!r}, 2, 1, timeout_s=30)\n"])
     # Process 0 starts once process 1 waits at the handshake, so its 1 s is all JAX's registration's:
     # no slow import of process 1 can make it a handshake refusal instead.
@@ -190,7 +190,7 @@ def test_where_jax_still_aborts_the_line_before_it_names_the_cause():
 
 
 def test_strangers_on_the_port_do_not_fail_the_handshake_and_one_too_many_is_told():
-    from octax_gym import handshake  # in threads: the handshake alone, without JAX
+    from octax_gym.step import handshake  # in threads: the handshake alone, without JAX
     port, outcomes = free_port(), {}
 
     def meet(process_id):

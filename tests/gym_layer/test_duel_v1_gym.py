@@ -10,7 +10,7 @@ import pytest
 
 import octax_gym
 from octax_gym import OpponentRequiredError
-from octax_gym.game_names import resolve_spec
+from octax_gym.envs.game_names import resolve_spec
 
 
 def test_duel_v1_is_octax_duel_v1_beside_v0():

@@ -1,4 +1,4 @@
-"""One game-name resolver (octax_gym/game_names.py) behind every place that takes a game by name.
+"""One game-name resolver (octax_gym/envs/game_names.py) behind every place that takes a game by name.
 
 Nothing here builds an env: the resolver reads the registry, and the entry points refuse an
 unknown name before they compile anything (`compiled_step.build` is stubbed where a good name
@@ -13,8 +13,9 @@ import re
 import pytest
 
 from octax_core.env.games import get_spec, list_games
-from octax_gym import UnknownOptionError, cli, compiled_step, env_id, video
-from octax_gym.game_names import resolve_env_id, resolve_spec
+from octax_gym import UnknownOptionError, cli, env_id, video
+from octax_gym.envs.game_names import resolve_env_id, resolve_spec
+from octax_gym.step import compiled_step
 
 
 @pytest.mark.parametrize("name", ["Pong", "pong", "PONG", "octax/Pong-v0", "OCTAX/pong-V0"])

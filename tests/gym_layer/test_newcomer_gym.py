@@ -22,7 +22,7 @@ import octax_core
 import octax_gym
 from octax_core.env.games import UnknownGameError, get_spec, list_games
 from octax_gym import OctaxEnv, OctaxVectorEnv, UnknownOptionError
-from octax_gym.game_names import resolve_spec
+from octax_gym.envs.game_names import resolve_spec
 
 from counter_game import COUNTER
 from two_player_games import TAKE_TURNS, TWO_COUNTERS

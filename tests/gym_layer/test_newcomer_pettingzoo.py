@@ -59,7 +59,7 @@ def test_every_agent_s_mask_samples_its_legal_actions(rom, kind):
 def test_the_one_seat_view_reports_its_own_seat_s_lives(rom, seat):
     """The Gymnasium view of one seat against an opponent says the same as PettingZoo's agent of
     that seat: player 1's count on seat 0, NO_LIVES (-1) on seat 1, never the opponent's count."""
-    from octax_gym.env import OctaxEnv
+    from octax_gym.envs.env import OctaxEnv
 
     env = OctaxEnv(WITH_LIVES, rom=rom, opponent="noop", seat=seat)
     _, info = env.reset(seed=0)

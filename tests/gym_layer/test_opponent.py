@@ -121,7 +121,7 @@ def test_every_two_player_game_is_registered():
     ids = [octax_gym.env_id(game) for game in octax_core.list_games(players=2)]
     assert list(octax_gym.TWO_PLAYER_ENV_IDS) == ids and "octax/SpaceRacer-v0" in ids
     for gym_id in ids:
-        assert gym.spec(gym_id).entry_point == "octax_gym.env:OctaxEnv"
+        assert gym.spec(gym_id).entry_point == "octax_gym.envs.env:OctaxEnv"
     for game in octax_core.list_games(players=2):
         if not octax_core.get_spec(game).solo:  # refused before anything is built
             with pytest.raises(OpponentRequiredError, match="pass opponent="):

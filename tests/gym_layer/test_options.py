@@ -14,8 +14,8 @@ import pytest
 from counter_game import COUNTER
 from octax_core.env.config import ENV_OPTIONS, EnvConfig, EnvParams, make_config
 from octax_gym import OctaxEnv, OctaxVectorEnv
-from octax_gym.env import SINGLE_KEYWORDS
-from octax_gym.vector import KEYWORDS
+from octax_gym.envs.env import SINGLE_KEYWORDS
+from octax_gym.envs.vector import KEYWORDS
 
 GYM_OPTIONS = [name for name in ENV_OPTIONS if name != "autoreset"]  # autoreset_mode replaces it
 

@@ -8,7 +8,8 @@ import pytest
 
 import octax_core
 from counter_game import COUNTER
-from octax_gym import OctaxEnv, OctaxVectorEnv, render
+from octax_gym import OctaxEnv, OctaxVectorEnv
+from octax_gym.envs import render
 
 
 def screens_of(envs) -> np.ndarray:

@@ -1,4 +1,4 @@
-"""The Stable-Baselines3 adapter (octax_gym/sb3.py): the VecEnv contract as SB3 2.x defines it,
+"""The Stable-Baselines3 adapter (octax_gym/integrations/sb3.py): the VecEnv contract as SB3 2.x defines it,
 SB3's own wrappers on it, the paper's CNN and PPO settings, and PPO learning on it.
 
 The contract tests run the Counter game (tests/counter_game.py) on 2 envs with max_episode_steps=4,

@@ -124,8 +124,8 @@ def test_every_game_is_registered_with_both_entry_points():
     assert list(octax_gym.ENV_IDS) == ids and len(ids) == len(octax_core.list_games()) >= 39
     for gym_id in ids:
         spec = gym.spec(gym_id)
-        assert spec.entry_point == "octax_gym.env:OctaxEnv"
-        assert spec.vector_entry_point == "octax_gym.vector:OctaxVectorEnv"
+        assert spec.entry_point == "octax_gym.envs.env:OctaxEnv"
+        assert spec.vector_entry_point == "octax_gym.envs.vector:OctaxVectorEnv"
     assert "octax/Pong-v0" in gym.registry and gym.register_envs(octax_gym) is None
 
 

@@ -17,8 +17,9 @@ import numpy as np
 import pytest
 
 import octax_gym
-from octax_gym import cli, render, video
-from octax_gym.game_names import resolve_env_id
+from octax_gym import cli, video
+from octax_gym.envs import render
+from octax_gym.envs.game_names import resolve_env_id
 from octax_gym.policies import POLICIES
 
 H264_FOURCCS = {"avc1", "h264"}

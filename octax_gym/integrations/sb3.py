@@ -25,9 +25,9 @@ from stable_baselines3.common.torch_layers import BaseFeaturesExtractor
 from stable_baselines3.common.vec_env import VecEnv, VecMonitor
 from stable_baselines3.common.vec_env.base_vec_env import VecEnvIndices, VecEnvObs, VecEnvStepReturn
 
+from octax_gym.envs.vector import OctaxVectorEnv
 from octax_gym.networks import FEATURES, OctaxCNN
-from octax_gym.compiled_step import MAX_SEED
-from octax_gym.vector import OctaxVectorEnv
+from octax_gym.step.compiled_step import MAX_SEED
 
 FIXED_KEYWORDS = ("autoreset_mode", "backend", "obs_scale")  # what SB3's contract decides for us
 

@@ -6,7 +6,7 @@ moves between a process's own lanes and the global batch the jitted step runs on
 it, lane block by lane block in device order. The env's step stays one jitted call, now on global
 arrays: XLA partitions the batched step over the devices (each runs its own lanes), and the few
 batch-wide decisions in it (a `lax.cond` taken when any lane needs it) become collectives. In a
-multi-process run (`octax_gym.distributed.initialize`, then every process makes the same env), each
+multi-process run (`octax_gym.step.distributed.initialize`, then every process makes the same env), each
 process feeds and reads only the lanes on its own devices: `env.num_envs` is that count,
 `env.global_env_ids` their indices in the global batch, and global env i is seeded `seed + i`
 whatever the process count, so it plays exactly as `gymnasium.make` seeded `seed + i`.
@@ -24,7 +24,7 @@ import jax
 import numpy as np
 from jax.sharding import Mesh, NamedSharding, PartitionSpec
 
-from octax_gym import backends
+from octax_gym.step import backends
 
 AXIS = "envs"
 
@@ -81,7 +81,7 @@ class Shards:
 
     def keys(self, local_seeds: Sequence[int]) -> jax.Array:
         """The global batch of typed PRNG keys, `jax.random.key(seed)` for each of this process's lanes."""
-        from octax_gym.compiled_step import keys_from_seeds
+        from octax_gym.step.compiled_step import keys_from_seeds
 
         return jax.random.wrap_key_data(self.to_global(jax.random.key_data(keys_from_seeds(list(local_seeds)))))
 

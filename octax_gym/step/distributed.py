@@ -32,7 +32,7 @@ from typing import Optional
 
 import jax
 
-from octax_gym import handshake
+from octax_gym.step import handshake
 
 TORCHRUN_VARIABLES = ("MASTER_ADDR", "MASTER_PORT", "WORLD_SIZE", "RANK")
 

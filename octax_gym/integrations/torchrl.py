@@ -28,8 +28,8 @@ from tensordict import TensorDict, TensorDictBase
 from torchrl.data import Bounded, Categorical, Composite, Unbounded
 from torchrl.envs import EnvBase
 
-from octax_gym.compiled_step import seeds_for
-from octax_gym.vector import OctaxVectorEnv
+from octax_gym.envs.vector import OctaxVectorEnv
+from octax_gym.step.compiled_step import seeds_for
 
 # Keywords this adapter fixes itself: the core must not autoreset and must hand back torch tensors.
 _FIXED = ("autoreset_mode", "backend")

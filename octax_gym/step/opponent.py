@@ -8,7 +8,7 @@ TorchRL and any one-agent Gymnasium code train on unchanged.
 
 `opponent=` (with `seat=`, the learner's side, 0 or 1) is a keyword of `OctaxEnv` and
 `OctaxVectorEnv`; it turns the env into the two-player env (`octax_core.make_multi`) seen from one
-seat, run by the same compiled step as every other env (`octax_gym.compiled_step`):
+seat, run by the same compiled step as every other env (`octax_gym.step.compiled_step`):
 
 * opponents: the core's table of players (`octax_core.env.players`), inside the jitted step:
   "noop" (holds no key), "random" (uniform over the actions open to it now: on a turn-based
@@ -31,7 +31,7 @@ seat, run by the same compiled step as every other env (`octax_gym.compiled_step
   simultaneous game) and `action_mask` (int8, (n,), as Gymnasium's `sample(mask=)` takes): the actions open to the learner now. In a
   turn-based game that is no-op alone while the opponent moves; any other action then, or one
   the game's `legal_fn` closes, raises `IllegalMoveError` (before the step for host actions,
-  deferred for device ones, as out-of-range actions: `octax_gym.action_check`). `OctaxEnv`
+  deferred for device ones, as out-of-range actions: `octax_gym.step.action_check`). `OctaxEnv`
   also has `action_masks()`, the method sb3-contrib's MaskablePPO reads.
 
 A game that is not a one-player env (`GameSpec.solo` False: a turn-based game that waits for its
@@ -49,7 +49,7 @@ import jax.numpy as jnp
 
 from octax_core.env import players
 from octax_core.env.games import GameSpec, list_games
-from octax_gym.choices import UnknownOptionError
+from octax_gym.envs.choices import UnknownOptionError
 
 OPPONENTS = tuple(players.PLAYERS)  # the opponents that run inside the jitted step (and "eps<p>")
 EPS_HINT = "'eps<p>' (the scripted player, a random action with probability p)"

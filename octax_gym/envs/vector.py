@@ -10,7 +10,7 @@ A step is one jitted call (key split, batched step, autoreset) with no host sync
 outputs reach numpy, JAX or torch without a copy (`backend=`). See docs/gymnasium.md.
 
 With `opponent=` (and `seat=`) a two-player game is one seat against a fixed opponent, still a
-one-player vector env to its caller (`octax_gym.opponent`, docs/pettingzoo.md); both seats at
+one-player vector env to its caller (`octax_gym.step.opponent`, docs/pettingzoo.md); both seats at
 once are `octax_gym.MultiAgentVectorEnv`, a subclass.
 """
 
@@ -25,13 +25,14 @@ import numpy as np
 from gymnasium import spaces
 from gymnasium.vector import AutoresetMode
 
-from octax_gym import action_check, backends, compiled_step, opponent as opponents, render, sharding
 from octax_core.emulator.state import screen_values, shown
 from octax_core.env.config import check_option_names
 from octax_core.validate import check_int
-from octax_gym.choices import UnknownOptionError, check_choice, check_names
-from octax_gym.compiled_step import GYM_ENV_OPTIONS, build, keys_from_seeds, seeds_for
-from octax_gym.game_names import resolve_spec
+from octax_gym.envs import render
+from octax_gym.envs.choices import UnknownOptionError, check_choice, check_names
+from octax_gym.envs.game_names import resolve_spec
+from octax_gym.step import action_check, backends, compiled_step, opponent as opponents, sharding
+from octax_gym.step.compiled_step import GYM_ENV_OPTIONS, build, keys_from_seeds, seeds_for
 
 FRAMES_PER_SECOND = 60  # the timer rate, on all three platforms; a step lasts frames_per_step frames
 RENDER_MODES = (None, "rgb_array")
@@ -75,7 +76,7 @@ class OctaxVectorEnv(gymnasium.vector.VectorEnv):
 
     Args:
         game: a registered game id ("Pong"; see `octax_core.list_games()`), its Gymnasium id
-            ("octax/Pong-v0"), either in any case (`octax_gym.game_names`), or a `GameSpec`.
+            ("octax/Pong-v0"), either in any case (`octax_gym.envs.game_names`), or a `GameSpec`.
         num_envs: number of envs in the batch.
         autoreset_mode: see above.
         backend: "numpy" (default), "jax" or "torch"; arrays are handed over without copies.
@@ -83,17 +84,17 @@ class OctaxVectorEnv(gymnasium.vector.VectorEnv):
             "cuda:1", a jax.Device or a torch.device.
         devices: the batch sharded over several devices, of this process or of every process of
             a `jax.distributed` run: "all", a list of devices, or a Mesh with an axis "envs"
-            (`octax_gym.sharding`). `num_envs` is then the global batch; the env's `num_envs` and
+            (`octax_gym.step.sharding`). `num_envs` is then the global batch; the env's `num_envs` and
             arrays are this process's lanes, `global_env_ids` their global indices. docs/scale.md.
         render_mode: None or "rgb_array" (`render()` returns a tuple of num_envs frames).
         render_scale: pixel size of a rendered frame (default 8: 512 x 256).
-        palette: a name from `octax_gym.render.PALETTES`, an (off, on) pair of RGB triples or
+        palette: a name from `octax_gym.envs.render.PALETTES`, an (off, on) pair of RGB triples or
             four (off, plane 1, plane 2, both: XO-CHIP's colours); None (the default) takes the
             game's own (`GameSpec.palette`), else "white".
         rom: an explicit ROM path (its SHA-1 must match the game's).
         opponent: for a two-player game (`octax_core.list_games(players=2)`), the fixed player of
             the other seat: "random", "noop", "scripted" (the game's bot) or a function of a batch
-            of the opponent's observations -> its num_envs actions (`octax_gym.opponent`). The
+            of the opponent's observations -> its num_envs actions (`octax_gym.step.opponent`). The
             env is then the learner's seat alone: observation (frames_per_step + 1, H, W), the
             last plane the player plane; its own reward; `info["action_mask"]` and
             `info["current_player"]`; a closed action raises `IllegalMoveError`. None (the
@@ -232,7 +233,7 @@ class OctaxVectorEnv(gymnasium.vector.VectorEnv):
         raises before anything runs), or a JAX array or torch tensor (never read here, so the
         step need not wait for whatever computes them: shape and dtype are checked at once,
         the range inside the step, and `InvalidActionError` surfaces at a later call; see
-        `octax_gym.action_check`).
+        `octax_gym.step.action_check`).
         """
         if self._state is None:
             raise gymnasium.error.ResetNeeded("call reset() before step()")

@@ -14,7 +14,7 @@ from __future__ import annotations
 from typing import Union
 
 from octax_core.env.games import GameSpec, close_names, get_spec, list_games
-from octax_gym.choices import UnknownOptionError
+from octax_gym.envs.choices import UnknownOptionError
 
 NAMESPACE = "octax"
 

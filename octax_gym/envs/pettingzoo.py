@@ -64,10 +64,10 @@ import numpy as np
 from gymnasium import spaces
 from pettingzoo import AECEnv, ParallelEnv
 
-from octax_gym.action_check import to_int
-from octax_gym.choices import check_choice
-from octax_gym.multi_vector import MultiAgentVectorEnv
-from octax_gym.opponent import NO_LIVES  # the one definition, shared with the one-seat view
+from octax_gym.envs.choices import check_choice
+from octax_gym.envs.multi_vector import MultiAgentVectorEnv
+from octax_gym.step.action_check import to_int
+from octax_gym.step.opponent import NO_LIVES  # the one definition, shared with the one-seat view
 
 FIXED_KEYWORDS = ("autoreset_mode", "backend")  # PettingZoo steps one episode of numpy arrays
 OFF_TURN = ("ignore", "raise")

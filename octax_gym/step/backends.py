@@ -3,7 +3,7 @@
 The env computes with JAX on one device. Its outputs are handed over without copies: numpy gets
 `np.asarray` of the CPU buffer (a read-only view), torch gets `torch.from_dlpack` (the tensor
 shares the JAX buffer, on the GPU too), jax gets the arrays themselves. torch is imported only
-when the torch backend is used. Actions come the other way, checked: `octax_gym.action_check`.
+when the torch backend is used. Actions come the other way, checked: `octax_gym.step.action_check`.
 """
 
 from __future__ import annotations
@@ -13,7 +13,7 @@ from typing import Any
 import jax
 import numpy as np
 
-from octax_gym.choices import UnknownOptionError, check_choice
+from octax_gym.envs.choices import UnknownOptionError, check_choice
 
 BACKENDS = ("numpy", "jax", "torch")
 
@@ -38,7 +38,7 @@ def resolve_device(device: Any) -> jax.Device:
     """None (JAX's default), a jax.Device, a torch.device, or "cpu", "gpu", "cuda", "cuda:1", "tpu".
 
     "cuda:1" is this process's second GPU, as in torch; in a multi-process run
-    (`octax_gym.distributed`) a device's global name as JAX prints it ("cpu:2048") works too.
+    (`octax_gym.step.distributed`) a device's global name as JAX prints it ("cpu:2048") works too.
 
     Raises:
         UnknownOptionError: no such device in this process; the message lists the available ones.

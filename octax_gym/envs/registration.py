@@ -6,7 +6,7 @@ import). Each id has an `entry_point` (`gymnasium.make` -> `OctaxEnv`) and a `ve
 (`gymnasium.make_vec` -> `OctaxVectorEnv`, one batched JAX call instead of N envs in a loop).
 
 The two-player games (`list_games(players=2)`) are registered too, the same way: with
-`opponent=` an id is one seat against a fixed opponent (`octax_gym.opponent`); a game that is
+`opponent=` an id is one seat against a fixed opponent (`octax_gym.step.opponent`); a game that is
 not a one-player env (`GameSpec.solo` False) raises `OpponentRequiredError` without it.
 
 Each game's spec carries its episode bound, `max_episode_steps` (the game's own, 4,500 steps for
@@ -29,7 +29,7 @@ from typing import Optional, Union
 import gymnasium
 
 from octax_core.env.games import GameSpec, get_spec, list_games
-from octax_gym.game_names import NAMESPACE, env_id  # noqa: F401  (where benchmarks and users import them)
+from octax_gym.envs.game_names import NAMESPACE, env_id  # noqa: F401  (where benchmarks and users import them)
 
 
 def register_all() -> list[str]:
@@ -52,8 +52,8 @@ def register_mix() -> str:
     `games=[...]` (or a named mix, "octax16", the default) and `weights=`."""
     gymnasium.register(
         id=MIX_ENV_ID,
-        entry_point="octax_gym.env:OctaxEnv",
-        vector_entry_point="octax_gym.vector:OctaxVectorEnv",
+        entry_point="octax_gym.envs.env:OctaxEnv",
+        vector_entry_point="octax_gym.envs.vector:OctaxVectorEnv",
         kwargs={"game": "octax16"},
         max_episode_steps=None,  # no one number: each game of a mix keeps its own bound
         disable_env_checker=False,
@@ -65,8 +65,8 @@ def _register(game: str) -> str:
     gym_id = env_id(game)
     gymnasium.register(
         id=gym_id,
-        entry_point="octax_gym.env:OctaxEnv",
-        vector_entry_point="octax_gym.vector:OctaxVectorEnv",
+        entry_point="octax_gym.envs.env:OctaxEnv",
+        vector_entry_point="octax_gym.envs.vector:OctaxVectorEnv",
         kwargs={"game": game, "max_episode_steps": None},  # see the module docstring
         max_episode_steps=get_spec(game).max_episode_steps,
         disable_env_checker=False,
@@ -94,8 +94,8 @@ def register_game(spec: GameSpec, rom: Optional[Union[str, os.PathLike]] = None)
     gym_id = env_id(spec)
     gymnasium.register(
         id=gym_id,
-        entry_point="octax_gym.env:OctaxEnv",
-        vector_entry_point="octax_gym.vector:OctaxVectorEnv",
+        entry_point="octax_gym.envs.env:OctaxEnv",
+        vector_entry_point="octax_gym.envs.vector:OctaxVectorEnv",
         kwargs={"game": spec, "rom": None if rom is None else str(rom), "max_episode_steps": None},
         max_episode_steps=spec.max_episode_steps,
         disable_env_checker=False,

@@ -153,7 +153,7 @@ def check_batch(actions: Any, num_envs: int, num_actions: int, game: str, source
 
 def to_host(actions: Any) -> Any:
     """Actions of any kind (a torch tensor, a JAX array, a list of either) read to numpy; what a
-    function opponent returns (`octax_gym.opponent`), checked afterwards by `check_batch`."""
+    function opponent returns (`octax_gym.step.opponent`), checked afterwards by `check_batch`."""
     if _torch_if_tensor(actions) is not None:
         return actions.detach().cpu().numpy()
     if isinstance(actions, jax.Array):

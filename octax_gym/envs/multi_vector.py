@@ -9,7 +9,7 @@ It is `OctaxVectorEnv` (a subclass) over the two-player core env (`octax_core.ma
 same compiled step, seeding, autoreset modes, backends (torch by DLPack, without copies), device,
 rendering and deferred device-action checks; only the action batch (num_envs, 2), the per-seat
 rewards and observations, and the turn-based checks differ. The PettingZoo envs
-(`octax_gym.pettingzoo`) run on it with num_envs=1. See docs/pettingzoo.md.
+(`octax_gym.envs.pettingzoo`) run on it with num_envs=1. See docs/pettingzoo.md.
 """
 
 from __future__ import annotations
@@ -23,9 +23,9 @@ from gymnasium import spaces
 from gymnasium.vector import AutoresetMode
 
 from octax_core.env.config import check_option_names
-from octax_gym import render
-from octax_gym.compiled_step import GYM_ENV_OPTIONS
-from octax_gym.vector import OctaxVectorEnv
+from octax_gym.envs import render
+from octax_gym.envs.vector import OctaxVectorEnv
+from octax_gym.step.compiled_step import GYM_ENV_OPTIONS
 
 
 class MultiAgentVectorEnv(OctaxVectorEnv):
@@ -58,7 +58,7 @@ class MultiAgentVectorEnv(OctaxVectorEnv):
     legal mask closes: a move by the seat whose turn it is not, or one the mover's
     `Seats.legal_fn` closes (rows whose episode has ended are not checked: their actions are
     ignored). Device actions (JAX arrays, torch tensors) are checked inside the jitted step and
-    raise at a later call, as in `OctaxVectorEnv` (`octax_gym.action_check`); a bad one is played
+    raise at a later call, as in `OctaxVectorEnv` (`octax_gym.step.action_check`); a bad one is played
     as no-op.
 
     Seeding and autoreset are `OctaxVectorEnv`'s: env i of a batch seeded s plays the game of a

@@ -12,12 +12,12 @@ what Gymnasium adds to the core:
   the rows that had ended before this step, SAME_STEP the rows that end in it, and a masked
   `reset` the rows asked for;
 * the info dict gets Gymnasium's `_name` masks, and SAME_STEP its batched `final_obs`/`final_info`;
-* device actions get their range checked in the step (`octax_gym.action_check`).
+* device actions get their range checked in the step (`octax_gym.step.action_check`).
 
 Two-player games run through the same class: built over a `MultiEnv` (`octax_core.make_multi`)
 the batch of actions is (N, 2), rewards (N, 2), observations (N, 2, F+1, H, W), and the device
 report also catches closed actions (`action_check.accumulate_seats`); that is
-`octax_gym.MultiAgentVectorEnv`. Built with a `View` (`octax_gym.opponent`) it is one seat against
+`octax_gym.MultiAgentVectorEnv`. Built with a `View` (`octax_gym.step.opponent`) it is one seat against
 a fixed opponent: the learner's actions (N,) go in, the opponent's are made inside the step (or
 come from the host), and the learner's observation, reward and info come out, so that
 `OctaxVectorEnv(game, opponent=...)` is a one-player env to every caller.
@@ -44,8 +44,8 @@ from octax_core.env import ENV_OPTIONS, Env, EnvConfig, EnvParams, EnvState, Gam
 from octax_core.env.games import list_games
 from octax_core.env.mix import MIXES, MixEnv
 from octax_core.env.multi import MultiEnv
-from octax_gym import action_check, opponent
-from octax_gym.game_names import resolve_spec
+from octax_gym.envs.game_names import resolve_spec
+from octax_gym.step import action_check, opponent
 
 # What the Gymnasium envs pass to the core: every env option but `autoreset`, which Gymnasium's
 # own `autoreset_mode` replaces.
@@ -100,7 +100,7 @@ class CompiledStep:
 
     def _step(self, keys, state: EnvState, actions, report, params: EnvParams, opponent_actions=None, *,
               mode: AutoresetMode):
-        """One batched step; also returns the action report (`octax_gym.action_check`) updated
+        """One batched step; also returns the action report (`octax_gym.step.action_check`) updated
         with this step's actions, as its last output. `opponent_actions` (N,): a host function
         opponent's (a view with opponent "callable" only)."""
         if self.players == 1:

@@ -12,7 +12,7 @@ import cv2
 import numpy as np
 
 from octax_core.validate import check_int
-from octax_gym.choices import check_choice
+from octax_gym.envs.choices import check_choice
 
 RGB = tuple[int, int, int]
 

@@ -5,7 +5,7 @@ seeded s and row i of a vector env seeded s - i play the same game step for step
 use `gymnasium.make_vec`: one batched call is far faster than many single envs.
 
 A two-player game is one seat against a fixed opponent with `opponent=` (and `seat=`):
-`gymnasium.make("octax/SpaceRacer-v0", opponent="scripted")`; see `octax_gym.opponent`.
+`gymnasium.make("octax/SpaceRacer-v0", opponent="scripted")`; see `octax_gym.step.opponent`.
 
 What a Gymnasium or ale-py user reaches for works as there: `env.spec.max_episode_steps` is where
 episodes are cut, `env.unwrapped.get_action_meanings()` names the actions, and
@@ -26,10 +26,10 @@ from gymnasium.envs.registration import EnvSpec
 from octax_core.env.config import check_option_names
 from octax_core.env.games import GameSpec
 from octax_core.env.mix import MixEnv
-from octax_gym import action_check
-from octax_gym import opponent as opponents
-from octax_gym.choices import UnknownOptionError
-from octax_gym.vector import FRAMES_PER_SECOND, KEYWORDS, RENDER_MODES, OctaxVectorEnv
+from octax_gym.envs.choices import UnknownOptionError
+from octax_gym.envs.vector import FRAMES_PER_SECOND, KEYWORDS, RENDER_MODES, OctaxVectorEnv
+from octax_gym.step import action_check
+from octax_gym.step import opponent as opponents
 
 SINGLE_KEYWORDS = tuple(k for k in KEYWORDS if k != "autoreset_mode")  # a single env never autoresets
 NO_BOUND = np.iinfo(np.int32).max  # an episode bound no episode reaches: the env's own bound, lifted
@@ -61,7 +61,7 @@ class OctaxEnv(gymnasium.Env):
     backend "jax" or "torch" the observation is a JAX array or a torch tensor sharing its buffer;
     reward, terminated and truncated are Python scalars whatever the backend.
 
-    Against an opponent (`opponent=`, `seat=`: `octax_gym.opponent`) the observation is the
+    Against an opponent (`opponent=`, `seat=`: `octax_gym.step.opponent`) the observation is the
     learner's, (frames_per_step + 1, H, W) with its player plane last; a function opponent takes
     one observation and returns one action; `info["action_mask"]` (int8 (n,), what
     `action_space.sample(mask=...)` takes; `action_masks()` gives it as bool) holds the actions
@@ -125,7 +125,7 @@ class OctaxEnv(gymnasium.Env):
         one, and not when `make` was given -1.
 
         The registered ids leave the env's own `max_episode_steps` keyword None in their kwargs
-        (`octax_gym.registration`): seeing that here, the env lifts its own bound, so that one
+        (`octax_gym.envs.registration`): seeing that here, the env lifts its own bound, so that one
         truncation, `TimeLimit`'s, cuts episodes where `env.spec.max_episode_steps` says, also
         when `make(id, max_episode_steps=M)` asks for more than the game's default (and none with
         -1). A spec whose kwargs give the keyword a number keeps it as the env's own bound.
@@ -180,7 +180,7 @@ class OctaxEnv(gymnasium.Env):
         """
         if isinstance(self._vector.core_env, MixEnv):
             raise ValueError(f"{self._vector.game_name}: action i holds game g's i-th key, a different key in each "
-                             "game; octax_gym.env.action_meanings(octax_core.get_spec(game)) names one game's")
+                             "game; octax_gym.envs.env.action_meanings(octax_core.get_spec(game)) names one game's")
         view = self._vector.view
         return action_meanings(self.game_spec, None if view is None else view.seat)
 
