@@ -59,7 +59,7 @@ def network_file(tmp_path_factory, two_counters_rom):
     params = ActorCritic().init(jax.random.key(0), jnp.zeros((1, *env.observation_shape), jnp.uint8))["params"]
     folder = tmp_path_factory.mktemp("agents")
 
-    def save(name: str, prefer=None, planes: int = 5):
+    def save(name: str, prefer=None, planes: int = 5, view=None):
         logits = params["Dense_1"]
         bias = jnp.zeros_like(logits["bias"]).at[9].set(9.0)
         bias = bias if prefer is None else bias.at[prefer].set(5.0)
@@ -67,7 +67,7 @@ def network_file(tmp_path_factory, two_counters_rom):
         torso = {**params["ConvTorso_0"], "Conv_0": {**conv, "kernel": conv["kernel"][:, :, :planes]}}
         tree = {"params": {**params, "ConvTorso_0": torso,
                            "Dense_1": {"kernel": jnp.zeros_like(logits["kernel"]), "bias": bias}}}
-        return save_agents(folder / name, ["TwoCounters-seed0"], jax.tree.map(lambda x: x[None], tree))[0]
+        return save_agents(folder / name, ["TwoCounters-seed0"], jax.tree.map(lambda x: x[None], tree), view=view)[0]
     return save
 
 
@@ -95,3 +95,25 @@ def test_sampled_draws_from_the_legal_softmax(network_file, two_counters_rom):
 def test_a_network_of_other_planes_is_refused(network_file, two_counters_rom):
     with pytest.raises(ValueError, match="reads 2 planes; TwoCounters's seats see 5"):
         _evaluate(network_file("two-planes", planes=2), two_counters_rom)
+
+
+def test_an_agent_trained_with_mirrored_seats_plays_in_the_mirrored_env(network_file, two_counters_rom):
+    """TwoCounters with mirrored seats whose keys swap (seat 1's key 1 is the game's key 2): a network
+    that holds key 1 scores 4 a step from seat 0 and, seeing the mirror image, 8 from seat 1."""
+    import dataclasses
+
+    from octax_core import make_multi
+    from octax_gym.cli.evaluate import agent_player
+
+    mirrored = dataclasses.replace(TWO_COUNTERS, seats=dataclasses.replace(
+        TWO_COUNTERS.seats, mirror="left-right", mirror_actions=(0, 2, 1)))
+    path = network_file("mirror", 1, view={"mirror": True})
+    result = evaluate(mirrored, str(path), opponents="noop", episodes=4, max_steps=10, rom=two_counters_rom)
+    first, second = (_evaluate(network_file(name, key), two_counters_rom)["rungs"][1] for name, key in
+                     (("first", 1), ("second", 2)))
+    assert result["mirror"] and [seat["margin"] for seat in result["rungs"][0]["by_seat"]] == \
+        [first["by_seat"][0]["margin"], second["by_seat"][1]["margin"]]
+    assert "mirrored seats: seat 1 sees the mirror image" in format_result(result)
+    plain_env, _ = make_multi(mirrored, rom=two_counters_rom)
+    with pytest.raises(ValueError, match="trained with mirrored seats .* play it in a mirrored env"):
+        agent_player(str(path), plain_env)
