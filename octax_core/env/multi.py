@@ -150,7 +150,7 @@ class MultiEnv(Env):
         plane = jnp.arange(self.players, dtype=frames.dtype) * jnp.asarray(self.config.obs_scale, frames.dtype)
         planes = jnp.broadcast_to(plane[:, None, None, None], (self.players, 1, *frames.shape[1:]))
         if self.mirrored:  # seat 1 sees the screens flipped across the game's axis
-            seen = jnp.stack([frames, jnp.flip(frames, axis=_MIRROR_AXIS[self.seats.mirror])])
+            seen = jnp.stack([frames, jnp.flip(frames, axis=MIRROR_AXIS[self.seats.mirror])])
         else:
             seen = jnp.broadcast_to(frames[None], (self.players, *frames.shape))
         return jnp.concatenate([seen, planes], axis=1)
@@ -162,7 +162,7 @@ class MultiEnv(Env):
         return scores
 
 
-_MIRROR_AXIS = {"left-right": -1, "top-bottom": -2}  # `Seats.mirror` -> the frames' axis it flips (W, H)
+MIRROR_AXIS = {"left-right": -1, "top-bottom": -2}  # `Seats.mirror` -> the frames' axis it flips (W, H)
 
 
 def make_multi(game: Union[str, GameSpec], *, rom=None, **options: Any) -> tuple[MultiEnv, EnvParams]:

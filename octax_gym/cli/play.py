@@ -86,7 +86,7 @@ def _cmd_play(args: argparse.Namespace) -> int:
     agent = None
     if args.agent is not None:
         from octax_gym.play.agents import load_agent
-        agent = load_agent(args.agent, num_actions, trust=args.trust_agent)
+        agent = load_agent(args.agent, num_actions, trust=args.trust_agent, spec=spec)
     players = None if args.players is None else [p.strip() for p in args.players.split(",")]
     if players is not None and len(players) != (2 if two else 1):
         raise ValueError(f"--players takes {2 if two else 1} name(s) for {spec.id}, got {args.players!r}")

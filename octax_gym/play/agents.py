@@ -31,12 +31,15 @@ from octax_gym import jax_policy
 Agent = Callable[[np.ndarray], int]
 
 
-def load_agent(path, num_actions: int, *, trust: bool = False) -> Agent:
+def load_agent(path, num_actions: int, *, trust: bool = False, spec=None) -> Agent:
     """The agent saved at `path` (.msgpack or .zip) for a game of `num_actions` actions.
 
     Args:
         trust: load an SB3 zip with SB3's own loader, which unpickles it (runs code stored in the
             file): only for files the user vouches for. Without it nothing in the file runs.
+        spec: the game's `GameSpec`; an agent trained with mirrored seats (`--mirror`, its file
+            says so) needs it: in seat 1 it is shown the mirror image and its action is mapped
+            back (`_as_trained`), as in the mirrored env it trained in.
 
     Raises:
         FileNotFoundError: no such file. ValueError: an unknown format, params that do not fit the
@@ -48,22 +51,43 @@ def load_agent(path, num_actions: int, *, trust: bool = False) -> Agent:
         raise FileNotFoundError(f"no agent file {path}")
     if zipfile.is_zipfile(path):
         return _sb3_agent(path, num_actions, trust)
-    return _jax_agent(path, num_actions)
+    return _jax_agent(path, num_actions, spec)
 
 
-def _jax_agent(path: Path, num_actions: int) -> Agent:
+def _jax_agent(path: Path, num_actions: int, spec=None) -> Agent:
     try:
-        params = jax_policy.load_params(path)
+        params, network = jax_policy.load_agent(path)
     except ImportError as exc:
         raise ImportError(f"--agent {exc}") from exc
     from octax_gym.train.networks import ACTIONS  # flax is there: the params loaded
 
-    network = jax_policy.describe(params)
     if network.num_actions < num_actions or (network.num_actions != num_actions and network.num_actions != ACTIONS):
         raise ValueError(f"{path} plays {network.num_actions} actions; this game has {num_actions}")
     # A trainer's agent has an output per key (ACTIONS); the game takes its first `num_actions`.
     greedy = jax.jit(lambda obs: jnp.argmax(jax_policy.action_scores(params, obs[None], num_actions), axis=-1)[0])
-    return _fit_channels(lambda obs: int(greedy(jnp.asarray(obs))), network.channels)
+    act = _fit_channels(lambda obs: int(greedy(jnp.asarray(obs))), network.channels)
+    return _as_trained(act, path, spec) if network.mirror else act
+
+
+def _as_trained(agent: Agent, path: Path, spec) -> Agent:
+    """An agent trained with mirrored seats, in the player's plain two-player env (where people
+    see and press what the game shows): from seat 1 (its player plane lit) it is shown the screens
+    flipped across the game's axis and its action is mapped through `Seats.mirror_actions`, which
+    is what `make_multi(..., mirror=True)` does for the seat it trained in."""
+    from octax_core.env.multi import MIRROR_AXIS
+
+    seats = getattr(spec, "seats", None)
+    if seats is None or seats.mirror is None:
+        raise ValueError(f"{path} was trained with mirrored seats (--mirror); "
+                         f"{getattr(spec, 'id', 'this game')} has none to play it in")
+    axis, to_game = MIRROR_AXIS[seats.mirror], np.asarray(seats.mirror_actions)
+
+    def mirrored(obs: np.ndarray) -> int:
+        obs = np.asarray(obs)
+        if not obs[-1].any():  # seat 0 sees the game as it is, mirrored or not
+            return agent(obs)
+        return int(to_game[agent(np.concatenate([np.flip(obs[:-1], axis=axis), obs[-1:]]))])
+    return mirrored
 
 
 def _sb3_agent(path: Path, num_actions: int, trust: bool) -> Agent:

@@ -117,3 +117,26 @@ def test_an_agent_trained_with_mirrored_seats_plays_in_the_mirrored_env(network_
     plain_env, _ = make_multi(mirrored, rom=two_counters_rom)
     with pytest.raises(ValueError, match="trained with mirrored seats .* play it in a mirrored env"):
         agent_player(str(path), plain_env)
+
+
+def test_the_browser_players_loader_shows_a_mirror_agent_seat_1_as_it_trained(network_file):
+    """`octax-gym play`'s env is plain (people see and press the game as it is); a --mirror agent in
+    seat 1 (player plane lit) plays its mirror-image action mapped back: key 1 held there is the
+    game's key 2 in TwoCounters with swapped mirrored keys, and seat 0 plays as it is."""
+    import dataclasses
+
+    import numpy as np
+
+    from octax_gym.play.agents import load_agent
+
+    mirrored = dataclasses.replace(TWO_COUNTERS, seats=dataclasses.replace(
+        TWO_COUNTERS.seats, mirror="left-right", mirror_actions=(0, 2, 1)))
+    path = network_file("mirror", 1, view={"mirror": True})
+    agent = load_agent(path, 3, spec=mirrored)
+    seat0 = np.zeros((5, 32, 64), np.uint8)
+    seat1 = seat0.copy()
+    seat1[-1] = 1  # the player plane of seat 1
+    assert (agent(seat0), agent(seat1)) == (1, 2)
+    assert load_agent(network_file("first", 1), 3, spec=mirrored)(seat1) == 1  # a plain agent is left alone
+    with pytest.raises(ValueError, match=r"trained with mirrored seats \(--mirror\); TwoCounters has none"):
+        load_agent(path, 3, spec=TWO_COUNTERS)
