@@ -81,8 +81,8 @@ def test_mirror_flips_seat_1_and_maps_its_actions_and_nothing_else(envs):
     (plain, params), (mirrored, _) = envs[False], envs[True]
     permutation = np.asarray(CYCLES.seats.mirror_actions)
     step_plain, step_mirrored = jax.jit(plain.step), jax.jit(mirrored.step)
-    obs_p, state_p = plain.reset(jax.random.key(7), params)
-    obs_m, state_m = mirrored.reset(jax.random.key(7), params)
+    obs_p, state_p = jax.jit(plain.reset)(jax.random.key(7), params)
+    obs_m, state_m = jax.jit(mirrored.reset)(jax.random.key(7), params)
     rng = np.random.default_rng(0)
     for t in range(60):
         np.testing.assert_array_equal(obs_m[0], obs_p[0])
@@ -103,18 +103,20 @@ def test_mirror_off_is_the_one_player_screen(envs):
     # The default path is unchanged: each seat's screens are the one-player env's, bit for bit.
     multi, params = envs[False]
     solo, solo_params = octax_core.make("Cycles")
-    obs_m, state_m = multi.reset(jax.random.key(1), params)
-    obs_s, state_s = solo.reset(jax.random.key(1), solo_params)
+    # jitted: an env step run op by op is thousands of tiny programs, compiled or read one by one
+    multi_step, solo_step = jax.jit(multi.step), jax.jit(solo.step)
+    obs_m, state_m = jax.jit(multi.reset)(jax.random.key(1), params)
+    obs_s, state_s = jax.jit(solo.reset)(jax.random.key(1), solo_params)
     for t in range(20):
         np.testing.assert_array_equal(obs_m[:, :-1], np.stack([obs_s, obs_s]))
         action = t % solo.num_actions
-        obs_m, state_m, *_ = multi.step(jax.random.key(t), state_m, jnp.asarray([action, 0]), params)
-        obs_s, state_s, *_ = solo.step(jax.random.key(t), state_s, jnp.int32(action), solo_params)
+        obs_m, state_m, *_ = multi_step(jax.random.key(t), state_m, jnp.asarray([action, 0]), params)
+        obs_s, state_s, *_ = solo_step(jax.random.key(t), state_s, jnp.int32(action), solo_params)
 
 
 def test_mirror_permutes_seat_1s_legal_mask_and_maps_back(envs):
     env, params = envs[True]
-    _, state = env.reset(jax.random.key(0), params)
+    _, state = jax.jit(env.reset)(jax.random.key(0), params)
     assert env.mirrored and not envs[False][0].mirrored
     assert env.legal_action_mask(state).all()  # simultaneous: every action open, mirrored or not
     actions = jnp.asarray([3, 3])
