@@ -289,7 +289,7 @@ def resolve_games(games: Union[str, tuple, list]) -> tuple:
     `MIXES`: the paper's 16 games) expands to its games, and `archive:DIR[:SPLIT]` to the GameSpecs of
     an `octax-gym generate` archive (`octax_gym.generated.load_archive`: its accepted games, of
     SPLIT "train" or "test", or both; `archive:DIR:NAME`, the one game NAME). Gymnasium ids and
-    any-case names are taken (`octax_gym.game_names`).
+    any-case names are taken (`octax_gym.envs.game_names`).
 
     Raises:
         UnknownOptionError: a name that is no registered game (the message lists the valid ones).
