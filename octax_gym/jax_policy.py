@@ -36,6 +36,7 @@ class Network(NamedTuple):
     num_actions: int  # the network's outputs; a game takes its first actions (no-op, then its keys)
     mirror: bool = False  # trained with mirrored seats (--mirror): play it in a mirrored env
 
+
 VIEW_KEYS = ("mirror",)  # what an agent file's "view" record may hold
 
 

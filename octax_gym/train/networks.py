@@ -90,7 +90,8 @@ def _patches_forward(x, kernel_size, strides):
 
 
 def _patches_backward(kernel_size, strides, shape, cotangent):
-    _, transpose = jax.vjp(lambda x: _sliced_patches(x, kernel_size, strides), jnp.zeros(shape, cotangent.dtype))
+    transpose = jax.linear_transpose(lambda x: _sliced_patches(x, kernel_size, strides),
+                                     jax.ShapeDtypeStruct(shape, cotangent.dtype))
     return transpose(cotangent)
 
 
