@@ -8,13 +8,15 @@ them, so `octax-gym play --agent` and the dataset suite (`octax_gym.datasets.sui
 the trained network. Needs flax (the `train` extra).
 
     params = load_params("runs/ppo/agents/Airplane-seed0.msgpack")
-    net = describe(params)                    # Network(kind="actor_critic", channels=4, num_actions=17, mirror=False)
+    net = describe(params)                    # Network(kind="actor_critic", channels=4, num_actions=17, ...)
     params, net = load_agent("runs/selfplay/agents/Cycles-seed0.msgpack")   # and how it sees its game
 
 An agent file may also hold a `"view"` record beside `"params"`: how the agent sees its game, which
 its params alone cannot tell. Today that is `{"mirror": True}` for a self-play agent trained with
 `--mirror` (seat 1 sees and plays the mirror image), which must be played in a mirrored env
-(`make_multi(..., mirror=True)`) to play what it learned; `octax-gym evaluate` reads it.
+(`make_multi(..., mirror=True)`) to play what it learned; `octax-gym evaluate` reads it. An agent
+of the paper's layout (`--network-layout paper`) records `{"layout": "paper", "planes": F}`: its
+params show the layout (its first kernel reads the 64 columns) but not how many frames it reads.
     act = sampling_policy(params, seed=0, num_actions=2)   # numpy (B, 4, 32, 64) -> numpy (B,) actions
 """
 
@@ -35,9 +37,11 @@ class Network(NamedTuple):
     channels: int  # input planes: the frames (plus a player plane for self-play agents)
     num_actions: int  # the network's outputs; a game takes its first actions (no-op, then its keys)
     mirror: bool = False  # trained with mirrored seats (--mirror): play it in a mirrored env
+    layout: str = "image"  # how its torso reads the frames (networks.LAYOUTS)
 
 
-VIEW_KEYS = ("mirror",)  # what an agent file's "view" record may hold
+VIEW_KEYS = ("mirror", "layout", "planes")  # what an agent file's "view" record may hold
+FRAMES = 4  # an env's frames per step by default: the planes of a paper-layout agent whose file does not say
 
 
 def load_params(path) -> dict:
@@ -51,7 +55,7 @@ def load_params(path) -> dict:
 
 def load_agent(path) -> tuple[dict, Network]:
     """(params, network) of the agent file at `path`: `load_params`' params, and `describe`'s
-    network with the file's view record (`mirror`) read.
+    network with the file's view record (`mirror`, `layout`, `planes`) read.
 
     Raises:
         ImportError: flax is missing. ValueError: not params of the package's networks, or a view
@@ -65,7 +69,7 @@ def load_agent(path) -> tuple[dict, Network]:
     try:
         saved = flax.serialization.msgpack_restore(path.read_bytes())
         view = dict(saved.pop("view", {}))
-        network = describe(saved)
+        network = describe(saved, view.get("planes"))
     except Exception as exc:  # msgpack's and KeyError's: not a params file of ours
         raise ValueError(f"{path} is not params saved by octax-gym train (flax msgpack of ActorCritic or "
                          f"QNetwork): {exc!r}") from None
@@ -73,18 +77,26 @@ def load_agent(path) -> tuple[dict, Network]:
     if unknown:
         raise ValueError(f"{path}: its view record holds {unknown}, which this version does not know "
                          f"(it knows {list(VIEW_KEYS)}); a newer octax-gym saved it")
+    if view.get("layout", network.layout) != network.layout:
+        raise ValueError(f"{path}: its view record says layout {view['layout']!r}, its params are of layout "
+                         f"{network.layout!r}: the file was altered")
     params = jax.tree.map(lambda x: jnp.asarray(x, jnp.float32) if np.asarray(x).dtype == np.float16 else jnp.asarray(x),
                           saved)
     return params, network._replace(mirror=bool(view.get("mirror", False)))
 
 
-def describe(params) -> Network:
-    """The kind, input planes and outputs of saved params (read from their shapes)."""
+def describe(params, planes: Optional[int] = None) -> Network:
+    """The kind, input planes, outputs and layout of saved params (read from their shapes; a
+    paper-layout network's planes, which its shapes do not show, are `planes`, else FRAMES)."""
     from octax_gym.train.networks import QNetwork, network_for
 
     network = network_for(params)
-    channels = int(params["params"]["ConvTorso_0"]["Conv_0"]["kernel"].shape[2])
-    return Network("q_network" if isinstance(network, QNetwork) else "actor_critic", channels, network.num_actions)
+    if network.layout == "image":
+        channels = int(params["params"]["ConvTorso_0"]["Conv_0"]["kernel"].shape[2])
+    else:
+        channels = int(planes) if planes is not None else FRAMES
+    return Network("q_network" if isinstance(network, QNetwork) else "actor_critic", channels, network.num_actions,
+                   layout=network.layout)
 
 
 def action_scores(params, obs: jax.Array, num_actions: Optional[int] = None) -> jax.Array:

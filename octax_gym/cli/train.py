@@ -126,6 +126,10 @@ def add_commands(commands: argparse._SubParsersAction) -> None:
     train.add_argument("--agent-map", default=None, choices=("auto", "vmap", "map"),
                        help="how agents share the program: vmap (batched, for a GPU), map (one after another: "
                             "bit for bit a lone run's), auto (map on a CPU, vmap elsewhere; the default)")
+    train.add_argument("--network-layout", default=None, choices=("image", "paper"),
+                       help="how the conv torso reads the frames: image (the paper's text: the 64 x 32 screen, "
+                            "frames as channels; the default) or paper (the paper's code: frames x rows, the 64 "
+                            "columns as channels), which learns Brix where image does not (docs/results/brix.md)")
     train.add_argument("--out-dir", type=Path, default=None, metavar="OUT",
                        help="where the run writes (default runs/<algo>-<games>-s<seed>)")
     train.add_argument("--resume", type=Path, default=None, metavar="OUT",
@@ -162,7 +166,7 @@ def config_from_args(args: argparse.Namespace):
         if given.get("games", (game,)) != (game,):
             raise ValueError(f"--games: {given['dataset']} is a dataset of {game}, not of {', '.join(given['games'])}")
         given["games"], given["env_overrides"] = (game,), dataset_overrides
-    for name in ("devices", "agent_map"):
+    for name in ("devices", "agent_map", "network_layout"):
         if getattr(args, name) is not None:
             given[name] = getattr(args, name)
     overrides = tuple((name, getattr(args, name)) for name in ENV_FLAGS if getattr(args, name) is not None)
@@ -201,7 +205,7 @@ def _cmd_train(args: argparse.Namespace) -> int:
 def _resumed(args: argparse.Namespace):
     """The config of the run in `--resume OUT` (its config.json); refuses other settings."""
     defaults = {"games": None, "eval_games": None, "preset": "cpu", "devices": None, "agent_map": None,
-                "out_dir": None, "anneal_lr": None,
+                "network_layout": None, "out_dir": None, "anneal_lr": None,
                 "clip_value_loss": None, "game_input": None, "save_at_evals": None, "mirror": None,
                 **{n: None for n in (*SETTINGS, *ENV_FLAGS)}}
     if given := [name for name, default in defaults.items() if getattr(args, name) != default]:

@@ -20,6 +20,7 @@ OFFLINE = ("bc", "cql")  # trained on a Minari dataset instead of a rollout (off
 DEVICES = ("", "all")
 ARCHIVE = "archive:"  # in games: archive:DIR[:SPLIT|:NAME], an `octax-gym generate` archive's games
 AGENT_MAPS = ("auto", "vmap", "map")
+NETWORK_LAYOUTS = ("image", "paper")  # networks.LAYOUTS: how the conv torso reads the frames
 ENV_FLAGS = {"max_episode_steps": int, "frames_per_step": int, "repeat_action_probability": float,
              "noop_max": int,  # octax_core.make options a run may override (for every game alike)
              "mirror": bool}  # make_multi's: selfplay's seat 1 sees and plays the mirror image (--mirror)
@@ -54,6 +55,7 @@ class TrainConfig:
     save_at_evals: bool = False  # keep every evaluation's agents too (agents/<name>-step<N>.msgpack): medium policies
     devices: str = ""  # "": one device; "all": every agent's envs split over every device
     agent_map: str = "auto"  # how agents share the program: vmap, map (one after another), auto (many.py)
+    network_layout: str = "image"  # the torso's layout (networks.LAYOUTS): the paper's text, or "paper", its code's
     env_overrides: tuple = ()  # ((name, value), ...) of ENV_FLAGS, for every game
     eval_games: tuple = ()  # games every agent is evaluated on too but never trains on (held-out variants)
     # PPO's
@@ -130,11 +132,15 @@ class TrainConfig:
             return [f"multitask-seed{seed}" for seed in self.seeds]
         return [f"{game}-seed{seed}" for game in self.game_ids for seed in self.seeds]
 
-    @property
-    def agent_view(self) -> dict:
-        """What the saved agents' files record of how they see their game (`jax_policy.VIEW_KEYS`):
-        {"mirror": True} for a --mirror run, else nothing (the files hold their params alone)."""
-        return {"mirror": True} if dict(self.env_overrides).get("mirror", False) else {}
+    def agent_view(self, planes: int) -> dict:
+        """What the saved agents' files record of how they see their game (`jax_policy.VIEW_KEYS`),
+        for agents that read `planes` input planes: {"mirror": True} for a --mirror run, and
+        {"layout": "paper", "planes": planes} for the paper's layout, whose params do not show how
+        many frames it reads; nothing for the default (the files hold their params alone)."""
+        view = {"mirror": True} if dict(self.env_overrides).get("mirror", False) else {}
+        if self.network_layout != "image":
+            view.update(layout=self.network_layout, planes=int(planes))
+        return view
 
     @property
     def row_agents(self) -> list[int]:
@@ -179,6 +185,7 @@ class TrainConfig:
         _choice("algorithm", self.algorithm, ALGORITHMS)
         _choice("devices", self.devices, DEVICES)
         _choice("agent_map", self.agent_map, AGENT_MAPS)
+        _choice("network_layout", self.network_layout, NETWORK_LAYOUTS)
         if not self.games:
             raise ValueError("games must name at least one game (comma-separated ids, or octax16)")
         if len(set(self.game_ids)) != len(self.game_ids):

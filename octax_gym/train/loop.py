@@ -122,13 +122,14 @@ def train(config: TrainConfig, out_dir, *, roms: Optional[Sequence] = None, prog
     if start_at is not None:
         bar.update(start_at["update"] * config.batch_size * num_agents)
     start = time.perf_counter()
+    view = config.agent_view(lanes.env.observation_shape[0])  # each seat's planes in self-play
 
     def evaluated(i, runner, train_s, totals):
         result = jax.device_get(evaluate(runner.params, fold(eval_keys, i), game_ids))
         rows = log.add(i, i * config.batch_size, time.perf_counter() - start, train_s, result, totals,
                        trainer.host_metrics(i))
         save_agents(out_dir, config.agent_names, runner.params, write=writer,
-                    step=i * config.batch_size if config.save_at_evals else None, view=config.agent_view)
+                    step=i * config.batch_size if config.save_at_evals else None, view=view)
         if writer:
             figure.draw(log.rows, config.game_ids, out_dir / "learning_curve.png", title)
         bar.set_postfix(eval=f"{np.mean([r['eval_mean_return'] for r in rows]):.2f}")

@@ -5,8 +5,13 @@
     masked(scores, legal)     # the actions a game does not take pushed to ILLEGAL
 
 Both agents read the frames with the same torso, as the paper does "for fair comparison" (Radji
-et al., section 5): three VALID convolutions of 32, 64 and 64 filters, kernels (8, 4), 4, 3 and
-strides (4, 2), 2, 1, ReLU after each, then one 256-unit ReLU layer per head. PQN adds LayerNorm
+et al., section 5): three convolutions of 32, 64 and 64 filters, kernels (8, 4), 4, 3 and strides
+(4, 2), 2, 1, ReLU after each, then one 256-unit ReLU layer per head. The torso reads the frames in
+one of two layouts (`LAYOUTS`, `--network-layout`): "image" (the default), the paper's text, the
+64 x 32 screen with the frames as channels; or "paper", the paper's released code, which hands
+flax the (F, 32, 64) frames as one NHWC image, so it convolves over frames x rows with the 64
+columns as channels (SAME padding). They differ in what they learn: on Brix the paper's layout
+learns in 131k CPU steps and ours stays at random level (docs/results/brix.md). PQN adds LayerNorm
 before the ReLU of its hidden layer (the paper: "and LayerNorm for PQN"; PQN relies on it in place
 of a target network, Gallici et al., 2024). `octax_gym.networks` is the torch twin (SB3, TorchRL).
 
@@ -29,6 +34,7 @@ import numpy as np
 
 HIDDEN = 256
 ACTIONS = 17  # no-op + 16 keys: every game's actions fit (octax_core's games take at most 16 keys)
+LAYOUTS = ("image", "paper")  # how the torso reads the frames (ConvTorso)
 ILLEGAL = -1e9  # a masked score: exp() of it is 0 and 0 * ILLEGAL is 0 (with -inf the entropy is nan)
 
 
@@ -113,17 +119,42 @@ class Conv(nn.Module):
         return conv_valid(x, kernel, self.strides) + bias
 
 
+LAYERS = ((32, (8, 4), (4, 2)), (64, (4, 4), (2, 2)), (64, (3, 3), (1, 1)))  # (filters, kernel, strides)
+
+
 class ConvTorso(nn.Module):
-    """The paper's feature extractor: (B, F, 32, 64) frames -> (B, 1024) for F = 4."""
+    """The paper's feature extractor: (B, F, 32, 64) frames -> (B, 1024) ("image") or (B, 512)
+    ("paper", for F <= 8)."""
+
+    layout: str = "image"
 
     @nn.compact
     def __call__(self, obs: jax.Array) -> jax.Array:
-        # (B, F, H=32, W=64) -> (B, 64, 32, F): the paper's (64, 32) image with the F frames as
-        # channels (NHWC), so its (8, 4) kernel spans 8 columns and 4 rows.
-        x = jnp.transpose(obs, (0, 3, 2, 1)).astype(jnp.float32)
-        for features, kernel, strides in ((32, (8, 4), (4, 2)), (64, (4, 4), (2, 2)), (64, (3, 3), (1, 1))):
-            x = nn.relu(Conv(features, kernel, strides)(x))  # 15x15x32 -> 6x6x64 -> 4x4x64
+        if self.layout == "paper":
+            # (B, F, 32, 64) as NHWC: height the F frames, width the 32 rows, the 64 columns as
+            # channels; SAME padding: 1x16x32 -> 1x8x64 -> 1x8x64.
+            x = obs.astype(jnp.float32)
+            for features, kernel, strides in LAYERS:
+                x = nn.relu(Conv(features, kernel, strides)(same_padded(x, kernel, strides)))
+        elif self.layout == "image":
+            # (B, F, H=32, W=64) -> (B, 64, 32, F): the paper's (64, 32) image with the F frames as
+            # channels (NHWC), so its (8, 4) kernel spans 8 columns and 4 rows. VALID padding.
+            x = jnp.transpose(obs, (0, 3, 2, 1)).astype(jnp.float32)
+            for features, kernel, strides in LAYERS:
+                x = nn.relu(Conv(features, kernel, strides)(x))  # 15x15x32 -> 6x6x64 -> 4x4x64
+        else:
+            raise ValueError(f"layout must be one of {', '.join(LAYOUTS)}, got {self.layout!r}")
         return x.reshape(x.shape[0], -1)
+
+
+def same_padded(x: jax.Array, kernel_size: tuple[int, int], strides: tuple[int, int]) -> jax.Array:
+    """(B, H, W, C) zero-padded as flax's (and TensorFlow's) SAME padding pads it: a VALID
+    convolution of the result is the SAME convolution of `x` (ceil(H / stride) outputs)."""
+    pads = [(0, 0)]
+    for size, kernel, stride in zip(x.shape[1:3], kernel_size, strides):
+        total = max((-(-size // stride) - 1) * stride + kernel - size, 0)
+        pads.append((total // 2, total - total // 2))
+    return jnp.pad(x, pads + [(0, 0)])
 
 
 class ActorCritic(nn.Module):
@@ -135,12 +166,13 @@ class ActorCritic(nn.Module):
 
     num_actions: int = ACTIONS
     num_games: int = 0
+    layout: str = "image"  # the torso's (LAYOUTS)
 
     @nn.compact
     def __call__(self, obs) -> tuple[jax.Array, jax.Array]:
         """Returns logits (B, num_actions) and values (B,)."""
         frames, game = obs if isinstance(obs, tuple) else (obs, None)
-        features = ConvTorso()(frames)
+        features = ConvTorso(self.layout)(frames)
         if self.num_games:
             features = jnp.concatenate([features, jax.nn.one_hot(game, self.num_games, dtype=features.dtype)], -1)
         # Orthogonal init as in CleanRL: small policy outputs start the policy near uniform.
@@ -159,11 +191,12 @@ class QNetwork(nn.Module):
     """
 
     num_actions: int = ACTIONS
+    layout: str = "image"  # the torso's (LAYOUTS)
 
     @nn.compact
     def __call__(self, obs: jax.Array) -> jax.Array:
         """Returns Q-values (B, num_actions)."""
-        features = ConvTorso()(obs)
+        features = ConvTorso(self.layout)(obs)
         hidden = nn.Dense(HIDDEN, kernel_init=orthogonal(math.sqrt(2)))(features)
         hidden = nn.relu(nn.LayerNorm()(hidden))
         return nn.Dense(self.num_actions, kernel_init=orthogonal(1.0))(hidden)
@@ -171,19 +204,26 @@ class QNetwork(nn.Module):
 
 def network_for(params) -> nn.Module:
     """The module that `params` (a saved `{"params": ...}` tree) belongs to, with its own output
-    width: QNetwork where the hidden layer has a LayerNorm, else ActorCritic (a multi-task
-    agent's game one-hot read from its first hidden layer's input width)."""
+    width and layout: QNetwork where the hidden layer has a LayerNorm, else ActorCritic (a
+    multi-task agent's game one-hot read from its first hidden layer's input width)."""
     p = params["params"]
-    width = int(p["Dense_1"]["kernel"].shape[1])
+    width, layout = int(p["Dense_1"]["kernel"].shape[1]), layout_of(p["ConvTorso_0"])
     if "LayerNorm_0" in p:
-        return QNetwork(width)
-    torso_width = _torso_width(p["ConvTorso_0"])
-    return ActorCritic(width, int(p["Dense_0"]["kernel"].shape[0]) - torso_width)
+        return QNetwork(width, layout)
+    torso_width = _torso_width(p["ConvTorso_0"], layout)
+    return ActorCritic(width, int(p["Dense_0"]["kernel"].shape[0]) - torso_width, layout)
 
 
-def _torso_width(torso) -> int:
-    """The torso's output width on a (32, 64) screen: 4 x 4 x the last convolution's filters."""
-    return 16 * int(torso["Conv_2"]["kernel"].shape[-1])
+def layout_of(torso) -> str:
+    """A torso's layout, read from its first kernel's input channels: the frames in "image"
+    (one to a few), the screen's 64 columns in "paper"."""
+    return "paper" if int(torso["Conv_0"]["kernel"].shape[2]) >= 32 else "image"
+
+
+def _torso_width(torso, layout: str) -> int:
+    """The torso's output width on a (32, 64) screen: 4 x 4 (image) or 1 x 8 (paper, up to 8
+    frames) x the last convolution's filters."""
+    return (16 if layout == "image" else 8) * int(torso["Conv_2"]["kernel"].shape[-1])
 
 
 def scores_of(network: nn.Module, params, obs) -> jax.Array:

@@ -82,7 +82,7 @@ def make_trainer(config: TrainConfig, lanes: Lanes) -> Trainer:
         raise ValueError(f"{config.algorithm} trains on {config.dataset}, a dataset of {game}: the run's games must "
                          f"be ({game},), got ({', '.join(lanes.games)})")
     data = load_transitions(config.dataset).device_put()
-    network, optimizer = QNetwork(), shared.make_optimizer(config)
+    network, optimizer = QNetwork(layout=config.network_layout), shared.make_optimizer(config)
     legal_of = jnp.asarray(lanes.legal)
     cql = config.algorithm == "cql"
     obs_shape = tuple(data.observations.shape[1:])

@@ -47,7 +47,7 @@ def make_trainer(config: TrainConfig, lanes: Lanes) -> Trainer:
     selves (selfplay.py) drawn before each rollout and playing the seats it picks.
     """
     num_games = len(lanes.games) if config.multitask and config.game_input else 0
-    network, optimizer = ActorCritic(num_games=num_games), shared.make_optimizer(config)
+    network, optimizer = ActorCritic(num_games=num_games, layout=config.network_layout), shared.make_optimizer(config)
     legal_of = jnp.asarray(lanes.legal)
 
     def net_input(obs, game):

@@ -35,7 +35,7 @@ def epsilon_greedy(q_values: jax.Array, key: jax.Array, epsilon, legal: jax.Arra
 
 def make_trainer(config: TrainConfig, lanes: Lanes) -> Trainer:
     """PQN for the run's lanes: a `Trainer` of one agent (the loop maps it over agents and compiles it)."""
-    network, optimizer = QNetwork(), shared.make_optimizer(config)
+    network, optimizer = QNetwork(layout=config.network_layout), shared.make_optimizer(config)
     legal_of = jnp.asarray(lanes.legal)
 
     def explore(params, key, obs, game, legal, epsilon):

@@ -111,7 +111,7 @@ def test_a_test_sized_suite_names_its_policies_and_keeps_their_params(tmp_path, 
         assert policy["eval_return"] == {"medium": 20.0, "expert": 40.0}[kind]
         kept = result.path / policy["params_file"]
         assert hashlib.sha256(kept.read_bytes()).hexdigest() == policy["params_sha256"]
-        assert jax_policy.describe(jax_policy.load_params(kept)) == ("actor_critic", 4, 17, False)
+        assert jax_policy.describe(jax_policy.load_params(kept)) == ("actor_critic", 4, 17, False, "image")
     # the policies' actions are the network's samples, not the random ones
     random_actions = np.concatenate([e.actions for e in minari.load_dataset("octax/Flak/random-v0").iterate_episodes()])
     expert_actions = np.concatenate([e.actions for e in minari.load_dataset("octax/Flak/expert-v0").iterate_episodes()])

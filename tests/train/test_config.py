@@ -31,6 +31,16 @@ def test_a_flag_overrides_its_preset_value():
     assert preset("paper", "ppo", num_envs=64, num_minibatches=8).num_envs == 64
 
 
+def test_the_network_layout_is_a_flag_of_every_algorithm():
+    from octax_gym.cli import build_parser
+    from octax_gym.cli.train import config_from_args
+
+    for algorithm, game in (("ppo", "Brix"), ("pqn", "Brix"), ("multitask", "Brix,Pong"), ("selfplay", "Cycles")):
+        args = build_parser().parse_args(["train", algorithm, "--games", game, "--network-layout", "paper"])
+        assert config_from_args(args).network_layout == "paper"
+    assert config_from_args(build_parser().parse_args(["train", "ppo"])).network_layout == "image"
+
+
 def test_octax16_is_the_cores_list_of_the_papers_games():
     assert resolve_games("octax16") == MIXES["octax16"] and len(MIXES["octax16"]) == 16
     assert resolve_games("airplane,octax/Deep8-v0") == ("Airplane", "Deep8")
@@ -76,5 +86,7 @@ def test_an_unknown_algorithm_is_a_usage_error(capsys):
 def test_check_names_the_setting():
     with pytest.raises(ValueError, match="agent_map must be one of"):
         dataclasses.replace(TrainConfig(), agent_map="pmap").check()
+    with pytest.raises(ValueError, match="network_layout must be one of 'image', 'paper', got 'columns'"):
+        dataclasses.replace(TrainConfig(), network_layout="columns").check()
     with pytest.raises(ValueError, match="env override must be one of"):
         dataclasses.replace(TrainConfig(), env_overrides=(("obs_scale", 255),)).check()

@@ -15,8 +15,8 @@ import pytest
 pytest.importorskip("flax")
 import flax.serialization  # noqa: E402
 from octax_gym.train import many, ppo, pqn  # noqa: E402
-from octax_gym.train.networks import (ACTIONS, ActorCritic, ConvTorso, QNetwork, _sliced_patches, conv_valid,  # noqa: E402
-                                      legal_actions, masked, network_for, patches)
+from octax_gym.train.networks import (ACTIONS, LAYERS, ActorCritic, ConvTorso, QNetwork, _sliced_patches,  # noqa: E402
+                                      conv_valid, legal_actions, masked, network_for, patches, same_padded)
 
 
 def test_network_shapes_and_a_fixed_width():
@@ -32,6 +32,42 @@ def test_network_shapes_and_a_fixed_width():
     q_params = jax.eval_shape(QNetwork().init, key, obs)
     assert isinstance(network_for(q_params), QNetwork) and isinstance(network_for(params), ActorCritic)
     assert network_for(jax.eval_shape(ActorCritic(3).init, key, obs)).num_actions == 3  # an examples' file
+
+
+def test_the_papers_layout_reads_the_columns_as_channels_and_is_read_back():
+    """--network-layout paper: the (F, 32, 64) frames as one NHWC image (frames x rows, the 64
+    columns as channels, SAME padding), as the paper's code hands them to flax; the saved params
+    say which layout they are (network_for), also with a multi-task agent's game input."""
+    key = jax.random.key(0)
+    for frames in (4, 5):  # 5: a self-play agent's player plane
+        obs = jax.ShapeDtypeStruct((2, frames, 32, 64), jnp.uint8)
+        features, params = jax.eval_shape(ConvTorso("paper").init_with_output, key, obs)
+        assert features.shape == (2, 512)
+        assert [params["params"][f"Conv_{i}"]["kernel"].shape for i in range(3)] == \
+            [(8, 4, 64, 32), (4, 4, 32, 64), (3, 3, 64, 64)]
+    obs = jax.ShapeDtypeStruct((2, 4, 32, 64), jnp.uint8)
+    for network in (ActorCritic(layout="paper"), QNetwork(layout="paper"), ActorCritic(num_games=3, layout="paper"),
+                    ActorCritic(num_games=3)):
+        inputs = (obs, jax.ShapeDtypeStruct((2,), jnp.int32)) if network.num_actions and getattr(
+            network, "num_games", 0) else obs
+        assert network_for(jax.eval_shape(network.init, key, inputs)) == network
+    with pytest.raises(ValueError, match="layout must be one of image, paper, got 'columns'"):
+        jax.eval_shape(ConvTorso("columns").init, key, obs)
+
+
+def test_same_padding_then_valid_is_flax_same_convolution():
+    """The paper layout's convolutions: `same_padded` then `conv_valid` computes flax's
+    nn.Conv(padding="SAME") of every layer, on the shapes the layout meets."""
+    import flax.linen as nn
+
+    x = _normal((2, 4, 32, 64), 0)
+    for i, (features, kernel, strides) in enumerate(LAYERS):
+        conv = nn.Conv(features, kernel, strides, padding="SAME")
+        params = conv.init(jax.random.key(i), x)["params"]
+        expected = conv.apply({"params": params}, x)
+        ours = conv_valid(same_padded(x, kernel, strides), params["kernel"], strides) + params["bias"]
+        np.testing.assert_allclose(ours, expected, rtol=1e-4, atol=1e-4)
+        x = expected
 
 
 def _normal(shape, seed):
@@ -197,24 +233,38 @@ def test_learn_passes_over_the_whole_rollout_each_epoch_and_counts_the_update():
 
 def test_an_agent_file_records_how_its_agent_sees_the_game(tmp_path):
     """A --mirror run's agents carry {"mirror": True} beside their params (`TrainConfig.agent_view`),
-    read back by `jax_policy.load_agent`; a plain run's files hold their params alone, as before."""
+    and a paper-layout run's its layout and planes (which its params do not show), read back by
+    `jax_policy.load_agent`; a plain run's files hold their params alone, as before."""
     from octax_gym import jax_policy
     from octax_gym.train import TrainConfig
     from octax_gym.train.checkpoints import save_agents
 
-    shapes = jax.eval_shape(ActorCritic().init, jax.random.key(0), jax.ShapeDtypeStruct((1, 5, 32, 64), jnp.uint8))
-    rng = np.random.default_rng(0)
-    params = jax.tree.map(lambda s: rng.normal(size=s.shape).astype(np.float32), shapes)
-    stacked = jax.tree.map(lambda x: x[None], params)
+    def saved_params(network):
+        shapes = jax.eval_shape(network.init, jax.random.key(0), jax.ShapeDtypeStruct((1, 5, 32, 64), jnp.uint8))
+        rng = np.random.default_rng(0)
+        params = jax.tree.map(lambda s: rng.normal(size=s.shape).astype(np.float32), shapes)
+        return params, jax.tree.map(lambda x: x[None], params)
+
+    params, stacked = saved_params(ActorCritic())
+    plain_config = TrainConfig(games=("Cycles",))
     mirrored = TrainConfig(algorithm="selfplay", games=("Cycles",), env_overrides=(("mirror", True),))
-    assert mirrored.agent_view == {"mirror": True} and TrainConfig(games=("Cycles",)).agent_view == {}
-    [plain] = save_agents(tmp_path / "plain", ["a"], stacked, view=TrainConfig(games=("Cycles",)).agent_view)
-    [seen] = save_agents(tmp_path / "mirror", ["a"], stacked, view=mirrored.agent_view)
+    assert mirrored.agent_view(5) == {"mirror": True} and plain_config.agent_view(5) == {}
+    [plain] = save_agents(tmp_path / "plain", ["a"], stacked, view=plain_config.agent_view(5))
+    [seen] = save_agents(tmp_path / "mirror", ["a"], stacked, view=mirrored.agent_view(5))
     assert plain.read_bytes() == flax.serialization.to_bytes(jax.tree.map(lambda x: x[0], stacked))  # as of old
     for path, mirror in ((plain, False), (seen, True)):
         loaded, network = jax_policy.load_agent(path)
-        assert network == ("actor_critic", 5, ACTIONS, mirror) and jax_policy.load_params(path).keys() == {"params"}
+        assert network == ("actor_critic", 5, ACTIONS, mirror, "image") and jax_policy.load_params(path).keys() == {"params"}
         assert all(np.array_equal(a, b) for a, b in zip(jax.tree.leaves(loaded), jax.tree.leaves(params)))
-    [unknown] = save_agents(tmp_path / "new", ["a"], stacked, view={"layout": "columns"})
-    with pytest.raises(ValueError, match=r"holds \['layout'\], which this version does not know \(it knows \['mirror'\]\)"):
+    paper_params, paper_stacked = saved_params(QNetwork(layout="paper"))
+    paper = TrainConfig(algorithm="pqn", network_layout="paper")
+    assert paper.agent_view(5) == {"layout": "paper", "planes": 5}
+    [columns] = save_agents(tmp_path / "paper", ["a"], paper_stacked, view=paper.agent_view(5))
+    assert jax_policy.load_agent(columns)[1] == ("q_network", 5, ACTIONS, False, "paper")
+    [unknown] = save_agents(tmp_path / "new", ["a"], stacked, view={"colours": 4})
+    with pytest.raises(ValueError, match=r"holds \['colours'\], which this version does not know \(it knows "
+                                         r"\['mirror', 'layout', 'planes'\]\)"):
         jax_policy.load_agent(unknown)
+    [wrong] = save_agents(tmp_path / "wrong", ["a"], stacked, view={"layout": "paper", "planes": 5})
+    with pytest.raises(ValueError, match="its view record says layout 'paper', its params are of layout 'image'"):
+        jax_policy.load_agent(wrong)
