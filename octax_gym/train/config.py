@@ -20,7 +20,7 @@ OFFLINE = ("bc", "cql")  # trained on a Minari dataset instead of a rollout (off
 DEVICES = ("", "all")
 ARCHIVE = "archive:"  # in games: archive:DIR[:SPLIT|:NAME], an `octax-gym generate` archive's games
 AGENT_MAPS = ("auto", "vmap", "map")
-NETWORK_LAYOUTS = ("image", "paper")  # networks.LAYOUTS: how the conv torso reads the frames
+NETWORK_LAYOUTS = ("image", "paper")  # how the conv torso reads the frames (networks.ConvTorso)
 ENV_FLAGS = {"max_episode_steps": int, "frames_per_step": int, "repeat_action_probability": float,
              "noop_max": int,  # octax_core.make options a run may override (for every game alike)
              "mirror": bool}  # make_multi's: selfplay's seat 1 sees and plays the mirror image (--mirror)

@@ -32,9 +32,10 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
+from octax_gym.train.config import NETWORK_LAYOUTS as LAYOUTS  # how the torso reads the frames (ConvTorso)
+
 HIDDEN = 256
 ACTIONS = 17  # no-op + 16 keys: every game's actions fit (octax_core's games take at most 16 keys)
-LAYOUTS = ("image", "paper")  # how the torso reads the frames (ConvTorso)
 ILLEGAL = -1e9  # a masked score: exp() of it is 0 and 0 * ILLEGAL is 0 (with -inf the entropy is nan)
 
 
