@@ -131,20 +131,16 @@ class ConvTorso(nn.Module):
 
     @nn.compact
     def __call__(self, obs: jax.Array) -> jax.Array:
-        if self.layout == "paper":
-            # (B, F, 32, 64) as NHWC: height the F frames, width the 32 rows, the 64 columns as
-            # channels; SAME padding: 1x16x32 -> 1x8x64 -> 1x8x64.
-            x = obs.astype(jnp.float32)
-            for features, kernel, strides in LAYERS:
-                x = nn.relu(Conv(features, kernel, strides)(same_padded(x, kernel, strides)))
-        elif self.layout == "image":
-            # (B, F, H=32, W=64) -> (B, 64, 32, F): the paper's (64, 32) image with the F frames as
-            # channels (NHWC), so its (8, 4) kernel spans 8 columns and 4 rows. VALID padding.
-            x = jnp.transpose(obs, (0, 3, 2, 1)).astype(jnp.float32)
-            for features, kernel, strides in LAYERS:
-                x = nn.relu(Conv(features, kernel, strides)(x))  # 15x15x32 -> 6x6x64 -> 4x4x64
-        else:
+        if self.layout not in LAYOUTS:
             raise ValueError(f"layout must be one of {', '.join(LAYOUTS)}, got {self.layout!r}")
+        paper = self.layout == "paper"
+        # image: (B, F, H=32, W=64) -> (B, 64, 32, F), the paper's (64, 32) image with the F frames
+        # as channels (NHWC), so its (8, 4) kernel spans 8 columns and 4 rows; VALID padding:
+        # 15x15x32 -> 6x6x64 -> 4x4x64. paper: (B, F, 32, 64) as it is, NHWC with height the F
+        # frames, width the 32 rows and the 64 columns as channels; SAME padding: 1x16x32 -> 1x8x64 -> 1x8x64.
+        x = (obs if paper else jnp.transpose(obs, (0, 3, 2, 1))).astype(jnp.float32)
+        for features, kernel, strides in LAYERS:
+            x = nn.relu(Conv(features, kernel, strides)(same_padded(x, kernel, strides) if paper else x))
         return x.reshape(x.shape[0], -1)
 
 

@@ -48,8 +48,7 @@ def test_the_papers_layout_reads_the_columns_as_channels_and_is_read_back():
     obs = jax.ShapeDtypeStruct((2, 4, 32, 64), jnp.uint8)
     for network in (ActorCritic(layout="paper"), QNetwork(layout="paper"), ActorCritic(num_games=3, layout="paper"),
                     ActorCritic(num_games=3)):
-        inputs = (obs, jax.ShapeDtypeStruct((2,), jnp.int32)) if network.num_actions and getattr(
-            network, "num_games", 0) else obs
+        inputs = (obs, jax.ShapeDtypeStruct((2,), jnp.int32)) if getattr(network, "num_games", 0) else obs
         assert network_for(jax.eval_shape(network.init, key, inputs)) == network
     with pytest.raises(ValueError, match="layout must be one of image, paper, got 'columns'"):
         jax.eval_shape(ConvTorso("columns").init, key, obs)

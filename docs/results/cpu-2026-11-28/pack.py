@@ -20,8 +20,7 @@ for name in ("progress.csv", "config.json", "summary.json", "learning_curve.png"
 def half(tree):
     if isinstance(tree, dict):
         return {key: half(value) for key, value in tree.items()}
-    array = np.asarray(tree) if isinstance(tree, np.ndarray) else tree
-    return array.astype(np.float16) if isinstance(array, np.ndarray) and array.dtype == np.float32 else array
+    return tree.astype(np.float16) if isinstance(tree, np.ndarray) and tree.dtype == np.float32 else tree
 
 
 for path in sorted((run / "agents").glob("*-seed[0-9].msgpack")):
