@@ -23,12 +23,13 @@ from typing import NamedTuple, Optional
 
 import jax
 import jax.numpy as jnp
+import numpy as np
 
 from octax_core.emulator import cpu, idle
 from octax_core.emulator.gate import _batch, when_any
 from octax_core.emulator.opcodes import Kind
 from octax_core.emulator.platforms import Platform
-from octax_core.emulator.quirks import Quirks, lane_quirks
+from octax_core.emulator.quirks import FIELDS, Quirks, lane_quirks
 from octax_core.emulator.state import shown
 
 
@@ -102,7 +103,7 @@ def _chunk(loop: Loop, keys, state, clock: Clock, profile):
         stalled = over | ~frame_going
         if counted:
             stalled = stalled | (count >= clock.target)
-        state, kind = cpu.execute(loop.platform, quirks, state, keys, stalled)
+        state, kind = _execute(loop.platform, quirks, state, keys, stalled)
         count = count + jnp.where(stalled, 0, 1)
         # The VIP's DXYN waits for the next vertical blank: the frame is over.
         if quirks.display_wait is True:
@@ -119,6 +120,26 @@ def _chunk(loop: Loop, keys, state, clock: Clock, profile):
     carry = (state, clock.count, no, no)
     (state, count, over, dirty), _ = jax.lax.scan(instruction, carry, None, length=loop.chunk)
     return state, count, over, dirty
+
+
+def _execute(platform: Platform, quirks: Quirks, state, keys, stalled):
+    """`cpu.execute`, traced once per process for each platform and set of fixed quirks.
+
+    Every program that runs a machine (an env's reset and step, a rollout, at any batch size)
+    traces the same instruction, and under `vmap` batches it again; as a jitted call JAX keeps
+    its jaxpr and the batched jaxpr, so the programs after the first trace only their own code.
+    XLA inlines the call: the optimized program is the same, instruction for instruction, as
+    with `cpu.execute` traced in place (docs/machine-log.md). A mix's quirks that differ per
+    machine (traced bools, `lane_quirks`) are arguments of the call, not part of its key."""
+    fixed = tuple((name, bool(value)) for name in FIELDS
+                  if isinstance(value := getattr(quirks, name), (bool, np.bool_)))
+    varying = {name: getattr(quirks, name) for name in FIELDS if name not in dict(fixed)}
+    return _execute_once(platform, fixed, state, keys, stalled, varying)
+
+
+@functools.partial(jax.jit, static_argnums=(0, 1))
+def _execute_once(platform: Platform, fixed: tuple[tuple[str, bool], ...], state, keys, stalled, varying):
+    return cpu.execute(platform, Quirks(**dict(fixed), **varying), state, keys, stalled)
 
 
 def _step(loop: Loop, keys, profile, carry):
