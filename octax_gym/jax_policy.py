@@ -126,18 +126,42 @@ def network_player(greedy: bool, planes: Optional[int] = None):
     return act
 
 
-def sampling_policy(params, seed: int, num_actions: Optional[int] = None) -> Callable[[np.ndarray], np.ndarray]:
-    """A batched policy for `collect_dataset`: actions sampled from the softmax of the network's
-    scores over the game's `num_actions` actions (the stochastic policy PPO trains and is
-    evaluated with), from a key chain of `seed` (call i folds i into it): the same seed, the
-    same actions."""
+def sampling_policy(params, seed: int, num_actions: Optional[int] = None,
+                    epsilon: Optional[float] = None) -> Callable[[np.ndarray], np.ndarray]:
+    """A batched policy for `collect_dataset`: the policy the trainer's sampled evaluation plays,
+    over the game's `num_actions` actions, from a key chain of `seed` (call i folds i into it):
+    the same seed, the same actions.
+
+    An actor-critic (PPO, self-play) samples from the softmax of its logits, the stochastic
+    policy PPO trains and is evaluated with. A Q-network (PQN, CQL) plays epsilon-greedy at
+    `epsilon` (None: `TrainConfig.eval_epsilon`, 0.005, the paper code's evaluation): the
+    softmax of Q-values, which lie close together, would be near-uniform play, not the agent's.
+    """
+    from octax_gym.train.config import TrainConfig
+    from octax_gym.train.networks import legal_actions
+    from octax_gym.train.pqn import epsilon_greedy
+
     key = jax.random.key(seed)
-    draw = jax.jit(lambda params, key, obs: jax.random.categorical(
-        key, action_scores(params, obs, num_actions)).astype(jnp.int32))
+    if describe(params).kind == "q_network":
+        epsilon = TrainConfig.eval_epsilon if epsilon is None else float(epsilon)
+        if not 0.0 <= epsilon <= 1.0:
+            raise ValueError(f"epsilon={epsilon}: a probability, from 0 (greedy) to 1 (uniform random)")
+
+        def choose(params, key, obs):
+            q_values = action_scores(params, obs)
+            count = q_values.shape[-1] if num_actions is None else num_actions
+            return epsilon_greedy(q_values, key, epsilon, legal_actions(count)[:q_values.shape[-1]])
+    elif epsilon is not None:
+        raise ValueError(f"epsilon={epsilon}: an actor-critic's actions are sampled from its softmax; "
+                         "epsilon is for a Q-network's (PQN, CQL) agent")
+    else:
+        def choose(params, key, obs):
+            return jax.random.categorical(key, action_scores(params, obs, num_actions)).astype(jnp.int32)
+    draw = jax.jit(choose)
     calls = iter(range(2 ** 31))
 
     def act(obs: np.ndarray) -> np.ndarray:
         return np.asarray(draw(params, jax.random.fold_in(key, next(calls)), jnp.asarray(obs)))
 
-    act.__name__ = "ppo_policy"
+    act.__name__ = "agent_policy"
     return act

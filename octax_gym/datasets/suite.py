@@ -157,7 +157,8 @@ def build_suite(runs_dir, games: Sequence[str] = GAMES, kinds: Sequence[str] = K
                 jax_policy.load_params(card.params_path), seed, num_actions=_num_actions(game))
             description = (f"octax/{game}-v0, {kind}: " + ("uniform random actions" if card is None else
                            f"{card.algorithm} after {card.steps_trained:,} steps (evaluation return "
-                           f"{card.eval_return:.2f}; random {card.random_return:.2f}), actions sampled") +
+                           f"{card.eval_return:.2f}; random {card.random_return:.2f}), actions "
+                           f"{'epsilon-greedy' if card.algorithm in ('PQN', 'CQL') else 'sampled'}") +
                            f"; {steps} steps from {num_envs} lanes, episodes capped at {EVAL_MAX_STEPS} steps, "
                            f"seeds from {seed}. Built by `octax-gym dataset suite`.")
             result = collect_dataset(game, dataset_id(game, kind), steps, num_envs=num_envs, policy=policy, seed=seed,

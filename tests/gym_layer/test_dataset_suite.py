@@ -136,3 +136,33 @@ def test_sampling_policy_draws_from_the_networks_softmax(tmp_path):
     assert 0.85 < np.mean(first == 2) < 0.97 and not np.array_equal(first, second)  # sampled, and the key moves on
     again = jax_policy.sampling_policy(jax_policy.load_params(path), seed=3)
     assert np.array_equal(again(obs), first)  # the same seed, the same actions
+
+
+def test_a_q_networks_policy_is_epsilon_greedy_not_its_softmax(tmp_path):
+    """A PQN agent plays what its sampled evaluation plays: the argmax of its Q-values, a random
+    legal action at eval_epsilon. The softmax of Q-values (close together) would be near uniform."""
+    import jax
+
+    from octax_gym.train.networks import ActorCritic, QNetwork
+
+    params = QNetwork().init(jax.random.key(1), np.zeros((1, 4, 32, 64), np.uint8))
+    bias = np.zeros(17, np.float32)
+    bias[2] = 0.5  # Q(2) leads by 0.5: the softmax would pick it about 1 time in 10 of 17 actions
+    params["params"]["Dense_1"]["bias"] = bias
+    kernel = np.asarray(params["params"]["Dense_1"]["kernel"])
+    params["params"]["Dense_1"]["kernel"] = np.zeros_like(kernel)  # every observation: the bias alone
+    path = tmp_path / "q.msgpack"
+    path.write_bytes(flax.serialization.to_bytes(params))
+    obs = np.random.default_rng(0).integers(0, 2, (4096, 4, 32, 64), dtype=np.uint8)
+    act = jax_policy.sampling_policy(jax_policy.load_params(path), seed=3, num_actions=5)
+    actions = act(obs)
+    assert actions.dtype == np.int32 and set(np.unique(actions)) <= set(range(5))  # the game's 5 actions only
+    assert 0.98 < np.mean(actions == 2) < 1.0  # greedy but for about 0.5% (x 4/5 elsewhere)
+    explored = jax_policy.sampling_policy(jax_policy.load_params(path), seed=3, num_actions=5, epsilon=0.5)(obs)
+    assert 0.55 < np.mean(explored == 2) < 0.65  # 0.5 + 0.5 / 5
+    with pytest.raises(ValueError, match="epsilon=1.5: a probability"):
+        jax_policy.sampling_policy(jax_policy.load_params(path), seed=3, epsilon=1.5)
+    actor_critic = tmp_path / "ppo.msgpack"
+    actor_critic.write_bytes(flax.serialization.to_bytes(ActorCritic(3).init(jax.random.key(1), obs[:1])))
+    with pytest.raises(ValueError, match="epsilon=0.1: an actor-critic's actions are sampled"):
+        jax_policy.sampling_policy(jax_policy.load_params(actor_critic), seed=3, epsilon=0.1)
