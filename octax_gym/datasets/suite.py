@@ -153,12 +153,13 @@ def build_suite(runs_dir, games: Sequence[str] = GAMES, kinds: Sequence[str] = K
         cards = pick_policies(run_for(runs_dir, game), game) if set(kinds) - {"random"} else {}
         for kind in kinds:
             card: Optional[PolicyCard] = cards.get(kind)
+            params = None if card is None else jax_policy.load_params(card.params_path)
             policy = "random" if card is None else jax_policy.sampling_policy(
-                jax_policy.load_params(card.params_path), seed, num_actions=_num_actions(game))
+                params, seed, num_actions=_num_actions(game))
+            played = "epsilon-greedy" if card and jax_policy.describe(params).kind == "q_network" else "sampled"
             description = (f"octax/{game}-v0, {kind}: " + ("uniform random actions" if card is None else
                            f"{card.algorithm} after {card.steps_trained:,} steps (evaluation return "
-                           f"{card.eval_return:.2f}; random {card.random_return:.2f}), actions "
-                           f"{'epsilon-greedy' if card.algorithm in ('PQN', 'CQL') else 'sampled'}") +
+                           f"{card.eval_return:.2f}; random {card.random_return:.2f}), actions {played}") +
                            f"; {steps} steps from {num_envs} lanes, episodes capped at {EVAL_MAX_STEPS} steps, "
                            f"seeds from {seed}. Built by `octax-gym dataset suite`.")
             result = collect_dataset(game, dataset_id(game, kind), steps, num_envs=num_envs, policy=policy, seed=seed,
