@@ -1,7 +1,9 @@
 """The three autoreset modes of OctaxVectorEnv, as row-by-row tables on the Counter game.
 
-Two envs, max_episode_steps=4. Env 0 holds key 2 (action 2, +8 a step) and reaches 24 at step 3:
-terminated. Env 1 holds key 1 (action 1, +4 a step) and is cut off at step 4 with 16: truncated.
+Three envs (the batch size of test_vector_env's Counter steps, which these share), max_episode_steps=4.
+Env 0 holds key 2 (action 2, +8 a step) and reaches 24 at step 3: terminated. Env 1 holds key 1
+(action 1, +4 a step) and is cut off at step 4 with 16: truncated. Env 2 holds nothing (0 a step)
+and is cut off at step 4 too; the tables leave it out, the masks and infos show it.
 Each row is (reward, terminated, truncated, info episode_step, info score) for env 0 | env 1.
 """
 
@@ -14,11 +16,11 @@ from gymnasium.vector import AutoresetMode
 from counter_game import COUNTER
 from octax_gym import OctaxVectorEnv
 
-ACTIONS = np.array([2, 1])
+ACTIONS = np.array([2, 1, 0])
 
 
 def make(counter_rom, mode):
-    return OctaxVectorEnv(COUNTER, 2, rom=counter_rom, autoreset_mode=mode, max_episode_steps=4)
+    return OctaxVectorEnv(COUNTER, 3, rom=counter_rom, autoreset_mode=mode, max_episode_steps=4)
 
 
 def row(reward, terminated, truncated, info, env):
@@ -69,10 +71,10 @@ def test_same_step(counter_rom):
     ]
     # final_obs / final_info: batched, rows marked by their masks.
     masks = [(list(i["_final_obs"]), list(i["_final_info"])) for i in infos]
-    assert masks == [([False, False],) * 2, ([False, False],) * 2, ([True, False],) * 2,
-                     ([False, True],) * 2, ([False, False],) * 2]
+    assert masks == [([False, False, False],) * 2, ([False, False, False],) * 2, ([True, False, False],) * 2,
+                     ([False, True, True],) * 2, ([False, False, False],) * 2]
     ended = infos[2]
-    assert ended["final_obs"].shape == (2, 4, 32, 64)
+    assert ended["final_obs"].shape == (3, 4, 32, 64)
     assert ended["final_info"]["score"][0] == 24 and ended["final_info"]["episode_step"][0] == 3
     assert infos[3]["final_info"]["score"][1] == 16 and infos[3]["final_info"]["episode_step"][1] == 4
     # The final observation is the last episode's (the digit drawn at y = 24 in the last frame),
@@ -96,8 +98,8 @@ def test_disabled(counter_rom):
     # Standing still: each frame is the screen the episode ended on.
     assert (observations[3][0] == observations[2][0][-1]).all() and (observations[4][0] == observations[3][0]).all()
     assert (observations[4][1] == observations[3][1][-1]).all()
-    obs, info = envs.reset(options={"reset_mask": np.array([True, False])})
-    assert list(info["episode_step"]) == [0, 4] and list(info["score"]) == [0, 16]
+    obs, info = envs.reset(options={"reset_mask": np.array([True, False, False])})
+    assert list(info["episode_step"]) == [0, 4, 4] and list(info["score"]) == [0, 16, 0]
     assert (obs[1] == observations[4][1]).all()  # the row not reset keeps its observation
     table, _, _ = play(envs, 1)
     assert table == [((8.0, False, False, 1, 8.0), (0.0, False, True, 4, 16.0))]

@@ -1,5 +1,9 @@
 """OctaxVectorEnv against N single envs, batch-size independence, seeding, partial resets, spaces,
-registration and Gymnasium's own vector wrappers."""
+registration and Gymnasium's own vector wrappers.
+
+Every Counter env here is one of a few compiled steps that the gym tests share (a step compiles
+once per game, options, autoreset mode and batch size): three envs (two where a second batch size
+is the point), RANDOM_KW or the defaults."""
 
 from __future__ import annotations
 
@@ -58,8 +62,8 @@ def test_vector_env_equals_single_envs_under_the_same_seeds(counter_rom):
 
 
 def test_trajectories_do_not_depend_on_the_batch_size(counter_rom):
-    actions = random_actions(12, 5, seed=1)
-    big = run_vector(OctaxVectorEnv(COUNTER, 5, rom=counter_rom, **RANDOM_KW), 7, actions)
+    actions = random_actions(12, 3, seed=1)
+    big = run_vector(OctaxVectorEnv(COUNTER, 3, rom=counter_rom, **RANDOM_KW), 7, actions)
     small = run_vector(OctaxVectorEnv(COUNTER, 2, rom=counter_rom, **RANDOM_KW), 7, actions[:, :2])
     for big_step, small_step in zip(big, small):
         for big_field, small_field in zip(big_step, small_step):
@@ -76,8 +80,10 @@ def test_same_seed_same_trajectory_other_seed_differs(counter_rom):
 
 def test_seed_list_and_unseeded_resets(counter_rom):
     envs = OctaxVectorEnv(COUNTER, 2, rom=counter_rom, **RANDOM_KW)
-    by_list = run_vector(envs, [5, 9], random_actions(4, 2))
-    by_int = run_vector(OctaxVectorEnv(COUNTER, 1, rom=counter_rom, **RANDOM_KW), 9, random_actions(4, 2)[:, 1:])
+    actions = random_actions(4, 2)
+    # seeded with the int 9, row 0 starts where the list's row 1 (seed 9) does
+    by_list = run_vector(envs, [5, 9], actions)
+    by_int = run_vector(OctaxVectorEnv(COUNTER, 3, rom=counter_rom, **RANDOM_KW), 9, np.repeat(actions[:, 1:], 3, axis=1))
     for a, b in zip(by_list, by_int):
         np.testing.assert_array_equal(a[0][1], b[0][0])
     envs.reset()  # no seed: the key chains go on, nothing raises
@@ -106,11 +112,12 @@ def test_reset_mask_resets_only_the_marked_rows(counter_rom):
 
 
 def test_spaces_and_dtypes(counter_rom):
-    envs = OctaxVectorEnv(COUNTER, 4, rom=counter_rom, obs_scale=255)
+    # two envs in SAME_STEP with obs_scale=255: test_sb3's compiled step (the mode changes no space)
+    envs = OctaxVectorEnv(COUNTER, 2, rom=counter_rom, obs_scale=255, autoreset_mode="same_step")
     assert envs.single_observation_space == gym.spaces.Box(0, 255, (4, 32, 64), np.uint8)
-    assert envs.observation_space.shape == (4, 4, 32, 64)
+    assert envs.observation_space.shape == (2, 4, 32, 64)
     assert envs.single_action_space == gym.spaces.Discrete(3)
-    assert envs.action_space == gym.spaces.MultiDiscrete([3, 3, 3, 4 - 1])
+    assert envs.action_space == gym.spaces.MultiDiscrete([3, 3])
     obs, info = envs.reset(seed=0)
     assert obs.dtype == np.uint8 and set(np.unique(obs)) <= {0, 255} and obs in envs.observation_space
     obs, reward, terminated, truncated, info = envs.step(envs.action_space.sample())
@@ -141,26 +148,26 @@ def test_make_and_make_vec_pick_our_envs():
 
 def test_record_episode_statistics(counter_rom):
     envs = gym.wrappers.vector.RecordEpisodeStatistics(
-        OctaxVectorEnv(COUNTER, 2, rom=counter_rom, max_episode_steps=4))
+        OctaxVectorEnv(COUNTER, 3, rom=counter_rom, max_episode_steps=4))
     envs.reset(seed=0)
     episodes = []
     for _ in range(8):
-        *_, info = envs.step(np.array([2, 1]))
+        *_, info = envs.step(np.array([2, 1, 1]))
         if "episode" in info:
             episodes += [(i, float(info["episode"]["r"][i]), int(info["episode"]["l"][i]))
                          for i in np.flatnonzero(info["_episode"])]
-    # env 0: +8 x 3 steps = 24 (terminated); env 1: +4 x 4 steps = 16 (truncated); NEXT_STEP resets
-    # in between do not count.
-    assert episodes == [(0, 24.0, 3), (1, 16.0, 4), (0, 24.0, 3)]
+    # env 0: +8 x 3 steps = 24 (terminated); envs 1 and 2: +4 x 4 steps = 16 (truncated); NEXT_STEP
+    # resets in between do not count.
+    assert episodes == [(0, 24.0, 3), (1, 16.0, 4), (2, 16.0, 4), (0, 24.0, 3)]
 
 
 def test_jax_to_torch_wrapper(counter_rom):
     torch = pytest.importorskip("torch", reason="the torch extra is part of `make test`")
-    envs = gym.wrappers.vector.JaxToTorch(OctaxVectorEnv(COUNTER, 2, rom=counter_rom, backend="jax"))
+    envs = gym.wrappers.vector.JaxToTorch(OctaxVectorEnv(COUNTER, 3, rom=counter_rom, backend="jax"))
     obs, info = envs.reset(seed=0)
-    assert isinstance(obs, torch.Tensor) and obs.dtype == torch.uint8 and obs.shape == (2, 4, 32, 64)
-    obs, reward, terminated, truncated, info = envs.step(torch.tensor([1, 2]))
-    assert reward.tolist() == [4.0, 8.0] and terminated.dtype == torch.bool
+    assert isinstance(obs, torch.Tensor) and obs.dtype == torch.uint8 and obs.shape == (3, 4, 32, 64)
+    obs, reward, terminated, truncated, info = envs.step(torch.tensor([1, 2, 0]))
+    assert reward.tolist() == [4.0, 8.0, 0.0] and terminated.dtype == torch.bool
 
 
 @pytest.mark.parametrize("mode", [AutoresetMode.NEXT_STEP, AutoresetMode.SAME_STEP])
