@@ -4,7 +4,7 @@ Levels of a family share their code and differ only in data bytes, so every leve
 cheap checks on the bare `Machine`, driven by its spec (start-up reaches play, the score moves,
 the game ends within a stated bound), and one level per family the env-API checks (a scripted
 episode, a random policy over 16 envs). JAX compiles dominate the cost: one machine runner for
-all levels, and one batched env per family, each built once.
+all levels, and one batched env for the three families' env tests (a mix), each built once.
 """
 
 from __future__ import annotations
@@ -12,11 +12,14 @@ from __future__ import annotations
 import functools
 
 import jax
+import jax.numpy as jnp
 import numpy as np
 import pytest
 
 import octax_core
 from octax_core.env.games import get_spec
+
+from game_harness import PinnedMix
 
 CAVERN = [f"Cavern{level}" for level in range(1, 8)]
 SPACE_FLIGHT = [f"SpaceFlight{level}" for level in range(1, 11)]
@@ -172,39 +175,65 @@ def test_space_flight_every_level_crosses_at_the_same_frames(game_id, octax_rom_
 # --- one level per family through the env API -----------------------------------------------
 
 
+# The env tests' three games, level 1 of each family, in one mix (`octax_core.make_mix`, the game
+# as data: one compiled step for the three) with autoreset, NUM_ENVS envs per game. `PinnedMix`
+# (game_harness) restarts an ended episode on its env's own game, as `make(game)`'s autoreset does,
+# and env g * NUM_ENVS + i is reset and stepped with the keys of `make(ENV_GAMES[g])`'s env i, so
+# each game's envs play exactly what `make(game, autoreset=True)` plays (the mix's exactness:
+# tests/core_env/test_mix.py).
+ENV_GAMES = ["Cavern1", "SpaceFlight1", "TargetShooter1"]
+
+
 @functools.cache
-def _batched_env(game_id: str, rom_dir):
-    """make() with autoreset, and jitted vmapped reset/step shared by this module's tests."""
-    env, params = octax_core.make(game_id, rom=rom_dir / get_spec(game_id).rom_file, autoreset=True)
-    reset = jax.jit(jax.vmap(env.reset, in_axes=(0, None)))
+def _batched_env(rom_dir):
+    """The mix with its jitted batched reset and step, shared by this module's env tests."""
+    specs = [get_spec(game_id) for game_id in ENV_GAMES]
+    env = PinnedMix(specs, None, dict(autoreset=True), [rom_dir / spec.rom_file for spec in specs])
+    params = env.default_params
+    games = jnp.repeat(jnp.arange(len(ENV_GAMES), dtype=jnp.int32), NUM_ENVS)
+    reset = jax.jit(jax.vmap(lambda key, game: env.reset(key, params, game=game)))
     step = jax.jit(jax.vmap(env.step, in_axes=(0, 0, 0, None)))
-    return env, params, reset, step
+    return env, params, lambda keys: reset(keys, games), step
+
+
+def _envs(game_id: str) -> slice:
+    """The mix's envs that play `game_id`."""
+    g = ENV_GAMES.index(game_id)
+    return slice(g * NUM_ENVS, (g + 1) * NUM_ENVS)
+
+
+def _each_game(keys):
+    """Keys of NUM_ENVS envs (on the last axis) -> the same keys for every game of the mix."""
+    return keys[..., np.tile(np.arange(NUM_ENVS), len(ENV_GAMES))]
 
 
 def _episode(game_id, rom_dir, policy, max_steps: int, seed: int = 0):
-    """Runs NUM_ENVS envs with actions policy(state) until each has ended once.
+    """Runs the game's NUM_ENVS envs with actions policy(V, episode_step) (the registers (N, 16)
+    and episode steps (N,) of its envs) until each has ended once; the mix's other envs hold no key.
 
     Returns:
         (step at which each env first ended (0: never), return up to then, first reset obs).
     """
-    _, params, reset, step = _batched_env(game_id, rom_dir)
-    obs, state = reset(jax.random.split(jax.random.key(seed), NUM_ENVS), params)
-    first_obs, ended_at, returns = np.asarray(obs), np.zeros(NUM_ENVS, int), np.zeros(NUM_ENVS)
-    keys = jax.random.split(jax.random.key(seed + 1), (max_steps, NUM_ENVS))
+    _, params, reset, step = _batched_env(rom_dir)
+    envs = _envs(game_id)
+    obs, state = reset(_each_game(jax.random.split(jax.random.key(seed), NUM_ENVS)))
+    first_obs, ended_at, returns = np.asarray(obs[envs]), np.zeros(NUM_ENVS, int), np.zeros(NUM_ENVS)
+    keys = _each_game(jax.random.split(jax.random.key(seed + 1), (max_steps, NUM_ENVS)))
+    actions = np.zeros(len(ENV_GAMES) * NUM_ENVS, np.int32)
     for t in range(max_steps):
-        actions = np.broadcast_to(policy(state), (NUM_ENVS,)).astype(np.int32)
+        actions[envs] = policy(np.asarray(state.machine.V[envs]), np.asarray(state.episode_step[envs]))
         obs, state, reward, terminated, truncated, _ = step(keys[t], state, actions, params)
         live = ended_at == 0
-        returns += np.where(live, np.asarray(reward), 0.0)
-        ended_at[live & np.asarray(terminated | truncated)] = t + 1
+        returns += np.where(live, np.asarray(reward[envs]), 0.0)
+        ended_at[live & np.asarray((terminated | truncated)[envs])] = t + 1
         if ended_at.all():
             break
     return ended_at, returns, first_obs
 
 
-def _cavern1_escape(state) -> int:
+def _cavern1_escape(V, episode_step) -> int:
     """From (52, 20): up to row 3, left to column 18, down to row 27, then left out of the cave."""
-    x, y = int(state.machine.V[0, 3]), int(state.machine.V[0, 4])
+    x, y = int(V[0, 3]), int(V[0, 4])
     if x >= 40 and y > 3:
         return 1  # key 2, up
     if x <= 18 and 5 < x and y < 27:
@@ -215,7 +244,7 @@ def _cavern1_escape(state) -> int:
 def test_env_cavern1_waits_then_crashes_left_and_escape_scores_max(octax_rom_dir):
     hold_left_from = 30
     ended_at, returns, obs = _episode(
-        "Cavern1", octax_rom_dir, lambda state: 2 if int(state.episode_step[0]) >= hold_left_from else 0, 100)
+        "Cavern1", octax_rom_dir, lambda V, episode_step: 2 if episode_step[0] >= hold_left_from else 0, 100)
     assert obs.shape == (NUM_ENVS, FRAMES_PER_STEP, 32, 64) and obs[0, -1, 31].all()
     assert (ended_at == hold_left_from + 12).all(), ended_at  # 12 steps of "left" from (52, 20)
     assert (returns == 9).all(), returns
@@ -225,10 +254,10 @@ def test_env_cavern1_waits_then_crashes_left_and_escape_scores_max(octax_rom_dir
 
 
 def test_env_space_flight1_crossing_and_crash(octax_rom_dir):
-    crossing = lambda state: ".^v".index(SPACE_FLIGHT1_CROSSING[min(int(state.episode_step[0]), 53)])
+    crossing = lambda V, episode_step: ".^v".index(SPACE_FLIGHT1_CROSSING[min(int(episode_step[0]), 53)])
     ended_at, returns, _ = _episode("SpaceFlight1", octax_rom_dir, crossing, 60)
     assert (ended_at == 53).all() and (returns == 30).all(), (ended_at, returns)
-    ended_at, returns, _ = _episode("SpaceFlight1", octax_rom_dir, lambda state: 0, 60)
+    ended_at, returns, _ = _episode("SpaceFlight1", octax_rom_dir, lambda V, episode_step: 0, 60)
     assert (ended_at == 10).all() and (returns == 5).all(), (ended_at, returns)
 
 
@@ -254,25 +283,35 @@ def test_env_space_flight1_at_5_frames_per_step_flies_past_the_crossing(octax_ro
 
 def test_env_target_shooter1_aiming_hits_ten(octax_rom_dir):
     ended_at, returns, _ = _episode(
-        "TargetShooter1", octax_rom_dir, lambda state: _aim(np.asarray(state.machine.V)), 300)
+        "TargetShooter1", octax_rom_dir, lambda V, episode_step: _aim(V), 300)
     assert ended_at.all() and (returns == 10).all(), (ended_at, returns)
     assert len(set(ended_at.tolist())) > 1, "every env saw the same targets: the reset key is not used"
+
+
+@functools.cache
+def _random_run(rom_dir):
+    """1,500 uniform random steps of the mix's envs (each game's actions over its own, drawn as
+    its own 16 envs would draw them): rewards (T, envs), episodes ended and truncated per env."""
+    env, params, reset, step = _batched_env(rom_dir)
+    steps = 1500
+    _, state = reset(_each_game(jax.random.split(jax.random.key(7), NUM_ENVS)))
+    actions = np.concatenate([np.random.default_rng(7).integers(0, len(get_spec(g).action_keys) + 1, (steps, NUM_ENVS),
+                                                                dtype=np.int32) for g in ENV_GAMES], axis=1)
+    keys = _each_game(jax.random.split(jax.random.key(8), (steps, NUM_ENVS)))
+    rewards, endings, truncations = [], 0, 0
+    for t in range(steps):
+        _, state, reward, terminated, truncated, _ = step(keys[t], state, actions[t], params)
+        rewards.append(reward)
+        endings += np.asarray(terminated).astype(int)
+        truncations += np.asarray(truncated).astype(int)
+    return np.asarray(rewards), endings, truncations
 
 
 @pytest.mark.parametrize("game_id, min_episodes", [("Cavern1", 100), ("SpaceFlight1", 500), ("TargetShooter1", 0)])
 def test_env_random_policy(game_id, min_episodes, octax_rom_dir):
     """16 envs x 1,500 random steps: finite 0/1 rewards, and (but Target Shooter 1) many endings."""
-    env, params, reset, step = _batched_env(game_id, octax_rom_dir)
-    steps = 1500
-    _, state = reset(jax.random.split(jax.random.key(7), NUM_ENVS), params)
-    actions = np.random.default_rng(7).integers(0, env.num_actions, (steps, NUM_ENVS), dtype=np.int32)
-    keys = jax.random.split(jax.random.key(8), (steps, NUM_ENVS))
-    rewards, endings = [], 0
-    for t in range(steps):
-        _, state, reward, terminated, truncated, _ = step(keys[t], state, actions[t], params)
-        rewards.append(reward)
-        endings += int(np.asarray(terminated).sum())
-        assert not np.asarray(truncated).any()
-    rewards = np.asarray(rewards)
-    assert np.isfinite(rewards).all() and set(np.unique(rewards)) <= {0.0, 1.0}
-    assert endings >= min_episodes, f"{game_id}: {endings} episodes ended"
+    rewards, endings, truncations = _random_run(octax_rom_dir)
+    envs = _envs(game_id)
+    assert not truncations[envs].any()
+    assert np.isfinite(rewards[:, envs]).all() and set(np.unique(rewards[:, envs])) <= {0.0, 1.0}
+    assert endings[envs].sum() >= min_episodes, f"{game_id}: {endings[envs].sum()} episodes ended"

@@ -4,8 +4,8 @@ Each seat's keys move its own side only; each seat's reward is its own score's c
 two sum to zero; the scripted policies (`Seats.scripted_policy`) beat uniform random play from
 either seat; episodes end. Cycles' two halves mirror each other exactly: the mirrored actions
 give the mirrored game. One jitted rollout per game (each env's per-step plan of both seats, an
-action, RANDOM or SCRIPTED, is an argument), 16 envs; Cycles2 (a speed between Cycles1's and
-Cycles3's) in make test-slow.
+action, RANDOM or SCRIPTED, is an argument), 16 envs, one program for all of Cycles' levels;
+Cycles2 (a speed between Cycles1's and Cycles3's) in make test-slow.
 That the committed ROMs are what the sources build is tests/core_tools/test_own_roms.py's (it
 globs roms/*.8o).
 """
@@ -39,14 +39,15 @@ def _env(game_id: str):
 def _rollout(game_id: str, steps: int):
     """(seed, plan (steps, NUM_ENVS, 2)) -> per-step rewards (T, N, 2), done (T, N), V (T, N, 16),
     for NUM_ENVS envs; a plan entry is RANDOM, SCRIPTED or an action (NOOP = 0). Episodes are not
-    reset once done. One compile per game: the tests that drive seats by hand use it too."""
+    reset once done. The tests that drive seats by hand use it too.
+
+    The reset is a small program of its own, and the rollout takes the start states, params and
+    keys as arguments: it holds no level's data (the start states carry the level), so Cycles'
+    levels, the same code, share one compiled rollout."""
     env, params = _env(game_id)
     policy = env.seats.scripted_policy
 
-    def one(key, plan):
-        reset_key, run_key = jax.random.split(key)
-        _, state = env.reset(reset_key, params)
-
+    def one(state, run_key, plan, params):
         def body(carry, inputs):
             state, done = carry
             key, wanted = inputs
@@ -64,13 +65,17 @@ def _rollout(game_id: str, steps: int):
 
         return jax.lax.scan(body, (state, jnp.bool_(False)), (jax.random.split(run_key, steps), plan))[1]
 
-    run = jax.jit(jax.vmap(one, in_axes=(0, 1)))
+    reset = jax.jit(jax.vmap(env.reset, in_axes=(0, None)))
+    run = jax.jit(jax.vmap(one, in_axes=(0, 0, 1, None)))
 
     def rollout(seed, plan):
         """`seed`: an int (env i resets from its own key) or one key, which every env resets from."""
         keys = jax.random.split(jax.random.key(seed), NUM_ENVS) if isinstance(seed, int) else \
             jnp.stack([seed] * NUM_ENVS)
-        return tuple(np.asarray(x).swapaxes(0, 1) for x in run(keys, jnp.asarray(plan, jnp.int32)))
+        split = jax.vmap(jax.random.split)(keys)
+        reset_keys, run_keys = split[:, 0], split[:, 1]
+        _, state = reset(reset_keys, params)
+        return tuple(np.asarray(x).swapaxes(0, 1) for x in run(state, run_keys, jnp.asarray(plan, jnp.int32), params))
     return rollout
 
 
