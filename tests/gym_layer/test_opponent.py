@@ -43,11 +43,13 @@ def test_scripted_opponent_runs_in_the_step(roms):
 
 
 def test_the_learner_in_seat_1(roms):
-    env = OctaxEnv(TWO_COUNTERS, rom=roms["counters"], opponent="noop", seat=1)
-    obs, _ = env.reset(seed=0)
-    assert (obs[-1] == 1).all()  # seat 1's player plane
-    _, reward, *_ = env.step(2)  # seat 1's second key: +2 a frame
-    assert reward == 8.0 and _counters(env) == [0, 8]
+    """Three envs: test_action_check's seat-1 view against noop, whose compiled step this shares."""
+    envs = OctaxVectorEnv(TWO_COUNTERS, 3, rom=roms["counters"], opponent="noop", seat=1)
+    obs, _ = envs.reset(seed=0)
+    assert (obs[:, -1] == 1).all()  # seat 1's player plane
+    _, reward, *_ = envs.step(np.full(3, 2))  # seat 1's second key: +2 a frame
+    assert reward.tolist() == [8.0] * 3
+    np.testing.assert_array_equal(envs.state.machine.V[:, :2], [[0, 8]] * 3)
 
 
 def test_a_function_opponent_sees_its_own_observation(roms):

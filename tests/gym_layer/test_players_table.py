@@ -10,7 +10,7 @@ import pytest
 
 from octax_core.env import players
 from octax_core.tools import trace
-from octax_gym import OctaxVectorEnv, opponent, policies
+from octax_gym import OctaxEnv, OctaxVectorEnv, opponent, policies
 from octax_gym.play import protocol
 
 from two_player_games import TWO_COUNTERS
@@ -23,11 +23,16 @@ def test_every_layer_names_the_one_table():
 
 
 def _opponent_counters(name, rom, steps=3) -> list[int]:
-    envs = OctaxVectorEnv(TWO_COUNTERS, 8, rom=rom, opponent=name)
-    envs.reset(seed=5)
-    for _ in range(steps):
-        envs.step(np.zeros(8, np.int64))  # the learner (seat 0) holds nothing
-    return np.asarray(envs.state.machine.V[:, 1]).tolist()  # the opponent's counter
+    """The opponent's counter after `steps` in 8 games (seeds 5..12) of one single env (its
+    compiled step, one per opponent, is test_opponent's: "scripted" there too)."""
+    env = OctaxEnv(TWO_COUNTERS, rom=rom, opponent=name)
+    counters = []
+    for seed in range(5, 13):
+        env.reset(seed=seed)
+        for _ in range(steps):
+            env.step(0)  # the learner (seat 0) holds nothing
+        counters.append(int(env.state.machine.V[0, 1]))  # the opponent's counter
+    return counters
 
 
 def test_the_ladders_players_are_opponents_too(two_counters_rom):
