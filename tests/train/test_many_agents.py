@@ -1,6 +1,8 @@
 """`octax-gym train` with many agents in one program: `--games Airplane,Deep8 --num-seeds 2` writes a
-row per (game, seed, evaluation) and an agent file each (PPO and PQN), and agent (Deep8, seed 1)
-learns, bit for bit, what `--games Deep8 --seed 1` alone learns (rows and params)."""
+row per (game, seed, evaluation) and an agent file each, and agent (Deep8, seed 1) learns, bit for
+bit, what `--games Deep8 --seed 1` alone learns (rows and params). Both runs are of one algorithm,
+`tiny_run.ALGORITHM` (PQN): the rows, the files and the exactness are the loop's and the agent
+map's, not an algorithm's (PPO's update is trained by the multi-task and self-play runs)."""
 
 from __future__ import annotations
 
@@ -10,7 +12,7 @@ from pathlib import Path
 import pytest
 
 pytest.importorskip("flax")
-from tiny_run import LONE, STEPS, TOGETHER  # noqa: E402
+from tiny_run import ALGORITHM, LONE, STEPS, TOGETHER  # noqa: E402
 
 
 def rows(out: Path) -> list[dict]:
@@ -18,9 +20,9 @@ def rows(out: Path) -> list[dict]:
         return list(csv.DictReader(file))
 
 
-@pytest.fixture(scope="module", params=["ppo", "pqn"])
-def together(request, trained) -> Path:
-    return trained(request.param, *TOGETHER)
+@pytest.fixture(scope="module")
+def together(trained) -> Path:
+    return trained(ALGORITHM, *TOGETHER)
 
 
 def test_a_row_per_game_seed_and_evaluation(together):
@@ -41,9 +43,9 @@ def test_a_row_per_game_seed_and_evaluation(together):
 
 
 def test_an_agent_of_many_learns_what_it_learns_alone(trained):
-    """PPO's alone: the exactness is the agent map's (test_parts: one by one is bit exact, for the Q
-    network's gradients too), not an algorithm's, so one lone run shows it."""
-    together, alone = trained("ppo", *TOGETHER), trained("ppo", *LONE)
+    """One algorithm's: the exactness is the agent map's (test_parts: one by one is bit exact, for the
+    Q network's gradients too), not an algorithm's, so one lone run shows it."""
+    together, alone = trained(ALGORITHM, *TOGETHER), trained(ALGORITHM, *LONE)
     mine = [r for r in rows(together) if (r["game"], r["seed"]) == ("Deep8", "1")]
     theirs = rows(alone)
     skip = {"wall_s", "env_steps_per_s"}  # timings

@@ -13,7 +13,7 @@ import pytest
 
 pytest.importorskip("flax")
 from octax_gym.cli import main  # noqa: E402
-from tiny_run import LONE, STEPS  # noqa: E402
+from tiny_run import ALGORITHM, LONE, STEPS  # noqa: E402
 
 
 def table(out: Path) -> list[dict]:
@@ -23,8 +23,8 @@ def table(out: Path) -> list[dict]:
 
 @pytest.fixture(scope="module")
 def whole(trained) -> Path:
-    """The lone PPO run of (Deep8, seed 1) (tiny_run.TINY: 6 updates, evaluations and checkpoints every 2)."""
-    return trained("ppo", *LONE)
+    """The lone run of (Deep8, seed 1) (tiny_run.ALGORITHM; TINY: 6 updates, evaluations and checkpoints every 2)."""
+    return trained(ALGORITHM, *LONE)
 
 
 def test_a_resumed_run_ends_as_the_run_never_stopped(whole, tmp_path):
@@ -34,19 +34,20 @@ def test_a_resumed_run_ends_as_the_run_never_stopped(whole, tmp_path):
     # As if killed just before its end: the checkpoint is at update 4, the last rows and agents
     # are those of update 6; the resumed run must drop the rows after update 4 and redo them.
     (cut / "agents" / "Deep8-seed1.msgpack").write_bytes(b"stale")
-    assert main(["train", "ppo", "--resume", str(cut), "--no-progress"]) == 0
+    assert main(["train", ALGORITHM, "--resume", str(cut), "--no-progress"]) == 0
     assert table(cut) == table(whole)
     assert [int(r["update"]) for r in table(cut)] == [0, 2, 4, 6]
     assert (cut / "agents" / "Deep8-seed1.msgpack").read_bytes() == (whole / "agents" / "Deep8-seed1.msgpack").read_bytes()
 
 
 def test_resume_is_refused_for_another_algorithm_or_without_a_checkpoint(whole, tmp_path, capsys):
-    assert main(["train", "pqn", "--resume", str(whole)]) == 1
-    assert "is a ppo run, not pqn" in capsys.readouterr().err
+    other = "ppo" if ALGORITHM != "ppo" else "pqn"
+    assert main(["train", other, "--resume", str(whole)]) == 1
+    assert f"is a {ALGORITHM} run, not {other}" in capsys.readouterr().err
     bare = tmp_path / "bare"
     bare.mkdir()
     shutil.copy(whole / "config.json", bare / "config.json")
-    assert main(["train", "ppo", "--resume", str(bare)]) == 1
+    assert main(["train", ALGORITHM, "--resume", str(bare)]) == 1
     assert "--checkpoint-every" in capsys.readouterr().err
 
 
