@@ -4,6 +4,8 @@ included), whichever games share the mix; the evaluation lanes start from distin
 
 from __future__ import annotations
 
+import functools
+
 import jax
 import jax.numpy as jnp
 import numpy as np
@@ -23,19 +25,21 @@ def lanes():
     return Lanes(["Airplane", "Deep8"], {"max_episode_steps": CAP}, eval_noop_max=30)
 
 
+@functools.partial(jax.jit, static_argnums=0)
 def _lane_rollout(lanes, game, key, actions):
-    def run(key, actions):
-        reset_key, key = jax.random.split(key)
-        obs, state = lanes.reset(reset_key, game, ENVS)
+    """The lanes' trajectory (obs, reward, terminated, truncated) and last state; one program for
+    every game (`game` is an argument)."""
+    reset_key, key = jax.random.split(key)
+    obs, state = lanes.reset(reset_key, game, ENVS)
 
-        def step(carry, action):
-            key, obs, state = carry
-            key, step_key = jax.random.split(key)
-            obs, state, reward, terminated, truncated, _ = lanes.step(step_key, state, action)
-            return (key, obs, state), (obs, reward, terminated, truncated)
+    def step(carry, action):
+        key, obs, state = carry
+        key, step_key = jax.random.split(key)
+        obs, state, reward, terminated, truncated, _ = lanes.step(step_key, state, action)
+        return (key, obs, state), (obs, reward, terminated, truncated)
 
-        return jax.lax.scan(step, (key, obs, state), actions)[1]
-    return jax.jit(run)(key, actions)
+    (_, _, state), trajectory = jax.lax.scan(step, (key, obs, state), actions)
+    return trajectory, state
 
 
 def _alone_rollout(env, params, key, actions):
@@ -58,7 +62,7 @@ def test_a_lane_of_the_mix_plays_what_its_game_plays_alone(lanes):
     env, params = octax_core.make("Deep8", autoreset=True, max_episode_steps=CAP)
     key = jax.random.key(7)
     actions = jax.random.randint(jax.random.key(8), (STEPS, ENVS), 0, env.num_actions)
-    mine = _lane_rollout(lanes, 1, key, actions)
+    mine, _ = _lane_rollout(lanes, 1, key, actions)
     theirs = _alone_rollout(env, params, key, actions)
     for name, a, b in zip(("obs", "reward", "terminated", "truncated"), mine, theirs):
         np.testing.assert_array_equal(np.asarray(a), np.asarray(b), err_msg=name)
@@ -66,10 +70,9 @@ def test_a_lane_of_the_mix_plays_what_its_game_plays_alone(lanes):
 
 
 def test_every_reset_keeps_the_lanes_game(lanes):
-    obs, state = lanes.reset(jax.random.key(0), 0, ENVS)
-    step = jax.jit(lanes.step)
-    for i in range(CAP + 2):
-        obs, state, *_ = step(jax.random.key(i), state, jnp.zeros(ENVS, jnp.int32))
+    """Airplane's lanes, the other game of the mix (the program of the test above, `game` its argument)."""
+    (_, _, terminated, truncated), state = _lane_rollout(lanes, 0, jax.random.key(0), jnp.zeros((STEPS, ENVS), jnp.int32))
+    assert (np.asarray(terminated) | np.asarray(truncated)).sum() >= ENVS * 3  # every lane restarted, again and again
     assert np.asarray(state.game).tolist() == [0] * ENVS and int(np.asarray(state.episode_step).max()) < CAP
 
 
@@ -86,7 +89,7 @@ def _distinct_machines(state, count: int) -> int:
 
 
 def test_evaluation_episodes_start_apart_and_training_ones_do_not(lanes):
-    _, evaluation = jax.jit(lambda k: lanes.reset(k, 1, 16, evaluation=True))(jax.random.key(0))
-    _, training = jax.jit(lambda k: lanes.reset(k, 1, 16))(jax.random.key(0))
+    evaluation, training = jax.jit(lambda k: (lanes.reset(k, 1, 16, evaluation=True)[1], lanes.reset(k, 1, 16)[1]))(
+        jax.random.key(0))  # both resets in one program
     assert _distinct_machines(evaluation, 16) > 4  # 0..30 no-op starts
     assert _distinct_machines(training, 16) == 1  # the run's env: no no-op starts unless asked

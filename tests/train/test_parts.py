@@ -62,7 +62,10 @@ def test_same_padding_then_valid_is_flax_same_convolution():
     x = _normal((2, 4, 32, 64), 0)
     for i, (features, kernel, strides) in enumerate(LAYERS):
         conv = nn.Conv(features, kernel, strides, padding="SAME")
-        params = conv.init(jax.random.key(i), x)["params"]
+        # any params will do: drawn here at the scale of flax's init (its shapes only: no init program to compile)
+        shapes = jax.eval_shape(conv.init, jax.random.key(i), x)["params"]
+        params = {"kernel": _normal(shapes["kernel"].shape, 10 + i) / np.sqrt(np.prod(shapes["kernel"].shape[:-1])),
+                  "bias": 0.1 * _normal(shapes["bias"].shape, 20 + i)}
         expected = conv.apply({"params": params}, x)
         ours = conv_valid(same_padded(x, kernel, strides), params["kernel"], strides) + params["bias"]
         np.testing.assert_allclose(ours, expected, rtol=1e-4, atol=1e-4)
