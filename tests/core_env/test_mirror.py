@@ -14,29 +14,25 @@ CYCLES = get_spec("Cycles")
 N, STEPS = 4, 160
 
 
-@pytest.fixture(scope="module")
-def envs():
-    return {mirror: octax_core.make_multi("Cycles", mirror=mirror) for mirror in (False, True)}
+# Every test here steps Cycles through the folder's `cycles` fixture (tests/core_env/conftest.py):
+# one compiled step per mirror setting, one env at a time; the players' actions are small
+# programs of their own, so the game played does not make another compile of the machine.
 
 
 @pytest.fixture(scope="module")
-def mirrored_play(envs):
+def mirrored_play(cycles):
     """Cycles from N resets: seat 0 plays the scripted player, seat 1 the same action in its mirrored
-    view (its own mirror image on the machine). Each step's observations, rewards and V3."""
-    env, params = envs[True]
-
-    @jax.jit
-    @jax.vmap
-    def play(key, state):
-        action = CYCLES.seats.scripted_policy(state.machine, 0)
-        obs, state, rewards, *_ = env.step(key, state, jnp.stack([action, action]), params)
-        return obs, state, rewards
-
-    _, state = jax.jit(jax.vmap(env.reset, in_axes=(0, None)))(jax.random.split(jax.random.key(3), N), params)
+    view (its own mirror image on the machine). Each step's observations, rewards and V3, (N, ...)."""
+    env, params, reset, step = cycles[True]
+    same_action = jax.jit(lambda machine: jnp.stack([CYCLES.seats.scripted_policy(machine, 0)] * 2))
+    states = [reset(key, params)[1] for key in jax.random.split(jax.random.key(3), N)]
     steps = []
     for t in range(STEPS):
-        obs, state, rewards = play(jax.random.split(jax.random.key(100 + t), N), state)
-        steps.append((np.asarray(obs), np.asarray(rewards), np.asarray(state.machine.V[:, 3])))
+        rows = []
+        for i, key in enumerate(jax.random.split(jax.random.key(100 + t), N)):
+            obs, states[i], rewards, *_ = step(key, states[i], same_action(states[i].machine), params)
+            rows.append((np.asarray(obs), np.asarray(rewards), np.asarray(states[i].machine.V[3])))
+        steps.append(tuple(np.stack(column) for column in zip(*rows)))
     return steps
 
 
@@ -74,15 +70,14 @@ def test_mirrored_cycles_see_the_same_game_but_for_a_sprite_drawn_a_frame_late(m
     assert in_play > 400 and 0.2 < cells / in_play < 0.8  # a move is two steps: about one in two
 
 
-def test_mirror_flips_seat_1_and_maps_its_actions_and_nothing_else(envs):
+def test_mirror_flips_seat_1_and_maps_its_actions_and_nothing_else(cycles):
     # The same game played with mirror off, seat 1's actions mapped through the permutation by
     # hand: seat 0's observation, the rewards, the state are the same, bit for bit, and seat 1's
     # observation is seat 0's screens flipped left-right (its player plane as before).
-    (plain, params), (mirrored, _) = envs[False], envs[True]
+    (plain, params, reset_plain, step_plain), (mirrored, _, reset_mirrored, step_mirrored) = cycles[False], cycles[True]
     permutation = np.asarray(CYCLES.seats.mirror_actions)
-    step_plain, step_mirrored = jax.jit(plain.step), jax.jit(mirrored.step)
-    obs_p, state_p = jax.jit(plain.reset)(jax.random.key(7), params)
-    obs_m, state_m = jax.jit(mirrored.reset)(jax.random.key(7), params)
+    obs_p, state_p = reset_plain(jax.random.key(7), params)
+    obs_m, state_m = reset_mirrored(jax.random.key(7), params)
     rng = np.random.default_rng(0)
     for t in range(60):
         np.testing.assert_array_equal(obs_m[0], obs_p[0])
@@ -99,13 +94,13 @@ def test_mirror_flips_seat_1_and_maps_its_actions_and_nothing_else(envs):
             np.testing.assert_array_equal(leaf_m, leaf_p)
 
 
-def test_mirror_off_is_the_one_player_screen(envs):
+def test_mirror_off_is_the_one_player_screen(cycles):
     # The default path is unchanged: each seat's screens are the one-player env's, bit for bit.
-    multi, params = envs[False]
+    multi, params, multi_reset, multi_step = cycles[False]
     solo, solo_params = octax_core.make("Cycles")
     # jitted: an env step run op by op is thousands of tiny programs, compiled or read one by one
-    multi_step, solo_step = jax.jit(multi.step), jax.jit(solo.step)
-    obs_m, state_m = jax.jit(multi.reset)(jax.random.key(1), params)
+    solo_step = jax.jit(solo.step)
+    obs_m, state_m = multi_reset(jax.random.key(1), params)
     obs_s, state_s = jax.jit(solo.reset)(jax.random.key(1), solo_params)
     for t in range(20):
         np.testing.assert_array_equal(obs_m[:, :-1], np.stack([obs_s, obs_s]))
@@ -114,15 +109,15 @@ def test_mirror_off_is_the_one_player_screen(envs):
         obs_s, state_s, *_ = solo_step(jax.random.key(t), state_s, jnp.int32(action), solo_params)
 
 
-def test_mirror_permutes_seat_1s_legal_mask_and_maps_back(envs):
-    env, params = envs[True]
-    _, state = jax.jit(env.reset)(jax.random.key(0), params)
-    assert env.mirrored and not envs[False][0].mirrored
+def test_mirror_permutes_seat_1s_legal_mask_and_maps_back(cycles):
+    env, params, reset, _ = cycles[True]
+    _, state = reset(jax.random.key(0), params)
+    assert env.mirrored and not cycles[False][0].mirrored
     assert env.legal_action_mask(state).all()  # simultaneous: every action open, mirrored or not
     actions = jnp.asarray([3, 3])
     np.testing.assert_array_equal(env.mirror_action(actions), [3, 4])
     np.testing.assert_array_equal(env.mirror_action(env.mirror_action(actions)), actions)
-    np.testing.assert_array_equal(envs[False][0].mirror_action(actions), actions)
+    np.testing.assert_array_equal(cycles[False][0].mirror_action(actions), actions)
 
 
 def test_mirror_actions_are_involutions_that_keep_noop():
@@ -156,7 +151,7 @@ def test_mirror_is_refused_where_there_is_no_mirrored_second_seat():
         octax_core.make_multi("Cycles", mirror="yes")
 
 
-def test_the_tables_players_play_the_same_game_in_a_mirrored_env():
+def test_the_tables_players_play_the_same_game_in_a_mirrored_env(cycles):
     """The scripted bot answers in the game's actions; in a mirrored env seat 1's answer is mapped
     into its mirrored view (`make_player(..., mirrored=True)`), so the bots on both seats play the
     same game, machine for machine, with and without mirroring; unmapped, seat 1's left and right
@@ -165,20 +160,16 @@ def test_the_tables_players_play_the_same_game_in_a_mirrored_env():
     from octax_core.env.players import make_player
 
     def play(mirror, mapped, steps=60):
-        env, params = octax_core.make_multi("Cycles", mirror=mirror)
+        env, params, reset, step = cycles[mirror]
         bot = make_player("scripted", env.spec, env.mirrored and mapped)
-
-        @jax.jit
-        @jax.vmap
-        def step(key, state):
-            both = jnp.stack([bot(None, key, None, state, jnp.int32(seat), None) for seat in (0, 1)])
-            return env.step(key, state, both, params)[1]
-
-        _, state = jax.vmap(env.reset, in_axes=(0, None))(jax.random.split(jax.random.key(3), N), params)
+        both = jax.jit(lambda key, state: jnp.stack([bot(None, key, None, state, jnp.int32(seat), None)
+                                                     for seat in (0, 1)]))
+        states = [reset(key, params)[1] for key in jax.random.split(jax.random.key(3), N)]
         registers = []
         for t in range(steps):
-            state = step(jax.random.split(jax.random.key(100 + t), N), state)
-            registers.append(np.asarray(state.machine.V))
+            keys = jax.random.split(jax.random.key(100 + t), N)
+            states = [step(key, state, both(key, state), params)[1] for key, state in zip(keys, states)]
+            registers.append(np.stack([np.asarray(state.machine.V) for state in states]))
         return np.stack(registers)
 
     plain = play(False, True)

@@ -45,35 +45,66 @@ def schip_game(tmp_path):
     return tiny_game(tmp_path, "schip", words, b"\x80")
 
 
-def test_xochip_observation_keeps_four_colours_apart(tmp_path):
-    spec, path = xochip_game(tmp_path)
-    for scale, values in ((1, (3, 1, 2)), (255, (255, 85, 170))):
-        env, params = octax_core.make(spec, rom=path, obs_scale=scale, frames_per_step=2)
-        obs, state = jax.jit(env.reset)(jax.random.key(0), params)  # the boot screen: dark
-        assert obs.shape == (2, 64, 128) == env.observation_shape and not obs.any()
-        obs = jax.jit(env.step)(jax.random.key(1), state, 0, params)[0]
-        assert obs.shape == (2, 64, 128) and obs.dtype == jnp.uint8
-        assert tuple(int(v) for v in obs[-1, 0, [0, 2, 4]]) == values
-        assert int(np.count_nonzero(np.asarray(obs[-1]))) == 3
-        assert env.observation_high == (3 if scale == 1 else 255)
+@pytest.fixture(scope="module")
+def games(tmp_path_factory):
+    """Both tiny games, written once for the module: platform -> (spec, ROM path)."""
+    folder = tmp_path_factory.mktemp("tiny")
+    return {"schip": schip_game(folder), "xochip": xochip_game(folder)}
 
 
-def test_schip_lores_pixels_fill_2x2_blocks_of_the_one_shape(tmp_path):
-    spec, path = schip_game(tmp_path)
-    env, params = octax_core.make(spec, rom=path, obs_scale=255)
-    obs, state = jax.jit(env.reset)(jax.random.key(0), params)
-    obs = jax.jit(env.step)(jax.random.key(1), state, 0, params)[0]
+@pytest.fixture(scope="module")
+def tiny(games):
+    """make() plus jitted reset and step, built once per (platform, options) for the module. The
+    tests all play obs_scale=255 (00FD's end does not depend on the scale), so they share one env
+    and one compiled step per platform."""
+    built = {}
+
+    def build(platform, **options):
+        key = (platform, tuple(sorted(options.items())))
+        if key not in built:
+            spec, path = games[platform]
+            env, params = octax_core.make(spec, rom=path, **options)
+            built[key] = env, params, jax.jit(env.reset), jax.jit(env.step)
+        return built[key]
+    return build
+
+
+def test_xochip_observation_keeps_four_colours_apart(tiny, games):
+    env, params, reset, step = tiny("xochip", obs_scale=255)
+    obs, state = reset(jax.random.key(0), params)  # the boot screen: dark
+    assert obs.shape == (4, 64, 128) == env.observation_shape and not obs.any()
+    obs = step(jax.random.key(1), state, 0, params)[0]
+    assert obs.shape == (4, 64, 128) and obs.dtype == jnp.uint8 and env.observation_high == 255
+    assert tuple(int(v) for v in obs[-1, 0, [0, 2, 4]]) == (255, 85, 170)
+    assert int(np.count_nonzero(np.asarray(obs[-1]))) == 3
+    # obs_scale=1 (the default): the same core step, batched by the vector env, whose compiled
+    # step the Gymnasium tests below share
+    from octax_gym import OctaxVectorEnv
+
+    spec, path = games["xochip"]
+    assert octax_core.make(spec, rom=path)[0].observation_high == 3
+    envs = OctaxVectorEnv(spec, 2, rom=path)
+    obs = envs.reset(seed=0)[0]
+    assert obs.shape == (2, 4, 64, 128) and not obs.any()
+    obs = envs.step(np.zeros(2, np.int64))[0]
+    assert obs.dtype == np.uint8 and tuple(int(v) for v in obs[0, -1, 0, [0, 2, 4]]) == (3, 1, 2)
+    assert int(np.count_nonzero(obs[0, -1])) == 3
+    envs.close()
+
+
+def test_schip_lores_pixels_fill_2x2_blocks_of_the_one_shape(tiny):
+    env, params, reset, step = tiny("schip", obs_scale=255)
+    obs, state = reset(jax.random.key(0), params)
+    obs = step(jax.random.key(1), state, 0, params)[0]
     assert obs.shape == (4, 64, 128) and env.observation_high == 255
     assert set(zip(*np.nonzero(np.asarray(obs[-1])))) == {(2, 6), (2, 7), (3, 6), (3, 7)}
     assert int(obs[-1, 2, 6]) == 255
 
 
-@pytest.mark.parametrize("make_game", [schip_game, xochip_game])
-def test_exit_ends_the_episode_and_the_machine_stands_still(tmp_path, make_game):
-    spec, path = make_game(tmp_path)
-    env, params = octax_core.make(spec, rom=path)
-    step = jax.jit(env.step)
-    obs, state = jax.jit(env.reset)(jax.random.key(0), params)
+@pytest.mark.parametrize("platform", ["schip", "xochip"])
+def test_exit_ends_the_episode_and_the_machine_stands_still(tiny, platform):
+    env, params, reset, step = tiny(platform, obs_scale=255)
+    obs, state = reset(jax.random.key(0), params)
     obs, state, reward, terminated, truncated, info = step(jax.random.key(1), state, 0, params)
     assert float(reward) > 0 and not bool(terminated)
     obs, state, reward, terminated, truncated, info = step(jax.random.key(2), state, 1, params)
@@ -83,10 +114,15 @@ def test_exit_ends_the_episode_and_the_machine_stands_still(tmp_path, make_game)
     assert all(np.array_equal(a, b) for a, b in zip(jax.tree.leaves(state.machine), jax.tree.leaves(again[1].machine)))
 
 
-def test_vector_env_space_and_frames(tmp_path):
+# The Gymnasium tests run the XO-CHIP game in 2 envs, as the observation test above does:
+# octax_gym compiles one step per (game, config, batch size), so they share it (a palette is
+# the renderer's, not the step's).
+
+
+def test_vector_env_space_and_frames(games):
     from octax_gym import OctaxVectorEnv
 
-    spec, path = xochip_game(tmp_path)
+    spec, path = games["xochip"]
     envs = OctaxVectorEnv(spec, 2, rom=path, render_mode="rgb_array", render_scale=2, palette="octo")
     assert envs.single_observation_space.shape == (4, 64, 128) and int(envs.single_observation_space.high.max()) == 3
     envs.reset(seed=0)
@@ -97,25 +133,26 @@ def test_vector_env_space_and_frames(tmp_path):
     octo = [(153, 102, 0), (255, 204, 0), (255, 102, 0), (102, 34, 0)]  # off, plane 1, plane 2, both
     assert [tuple(frames[0][0, 2 * x]) for x in (6, 2, 4, 0)] == octo
     envs.close()
-    pair = OctaxVectorEnv(spec, 1, rom=path, render_mode="rgb_array", render_scale=1, palette=[(0, 0, 0), (200, 100, 0)])
+    pair = OctaxVectorEnv(spec, 2, rom=path, render_mode="rgb_array", render_scale=1, palette=[(0, 0, 0), (200, 100, 0)])
     pair.reset(seed=0)
-    pair.step(np.zeros(1, np.int64))
+    pair.step(np.zeros(2, np.int64))
     assert [tuple(pair.render()[0][0, x]) for x in (6, 2, 4, 0)] == [(0, 0, 0), (200, 100, 0), (100, 50, 0), (50, 25, 0)]
     pair.close()
 
 
-def test_a_game_brings_its_own_palette(tmp_path):
+def test_a_game_brings_its_own_palette(games):
     import dataclasses
 
     from octax_gym import OctaxVectorEnv
 
-    spec, path = schip_game(tmp_path)
-    spec = dataclasses.replace(spec, palette=((10, 20, 30), (40, 50, 60)))
-    envs = OctaxVectorEnv(spec, 1, rom=path, render_mode="rgb_array", render_scale=1)
+    spec, path = games["xochip"]
+    own = ((10, 20, 30), (40, 50, 60), (70, 80, 90), (100, 110, 120))  # off, plane 1, plane 2, both
+    spec = dataclasses.replace(spec, palette=own)
+    envs = OctaxVectorEnv(spec, 2, rom=path, render_mode="rgb_array", render_scale=1)
     envs.reset(seed=0)
-    envs.step(np.zeros(1, np.int64))
+    envs.step(np.zeros(2, np.int64))
     frame = envs.render()[0]
-    assert frame.shape == (64, 128, 3) and tuple(frame[2, 6]) == (40, 50, 60) and tuple(frame[0, 0]) == (10, 20, 30)
+    assert frame.shape == (64, 128, 3) and [tuple(frame[0, x]) for x in (6, 2, 4, 0)] == list(own)
     envs.close()
 
 
@@ -124,6 +161,6 @@ def test_unknown_platform_in_a_spec(tmp_path):
         tiny_game(tmp_path, "superchip", (0x1200,), b"")
 
 
-def test_the_env_contract_suite_passes_on_xochip(tmp_path):
-    spec, path = xochip_game(tmp_path)
+def test_the_env_contract_suite_passes_on_xochip(games):
+    spec, path = games["xochip"]
     octax_core.check_env(spec, rom=path)  # shapes, dtypes, determinism whatever the batch, ...

@@ -18,20 +18,17 @@ DRAWS = 4000
 
 
 @pytest.fixture(scope="module")
-def cycles_states():
+def cycles_states(cycles):
     """32 Cycles games after 24 random steps each: states where the scripted player turns (before
-    step 12 it goes straight in every game)."""
-    env, params = octax_core.make_multi("Cycles")
-    keys = jax.random.split(jax.random.key(3), 32)
-    obs, state = jax.vmap(env.reset, in_axes=(0, None))(keys, params)
-
-    def walk(carry, t):
-        obs, state = carry
-        actions = jax.random.randint(jax.random.fold_in(jax.random.key(4), t), (32, 2), 0, env.num_actions)
-        obs, state, *_ = jax.vmap(env.step, in_axes=(0, 0, 0, None))(keys, state, actions, params)
-        return (obs, state), None
-
-    (obs, state), _ = jax.lax.scan(walk, (obs, state), jnp.arange(24))
+    step 12 it goes straight in every game). Stepped one game at a time by the folder's compiled
+    Cycles step (tests/core_env/conftest.py), then stacked: (32, ...) observations and states."""
+    env, params, reset, step = cycles[False]
+    keys = list(jax.random.split(jax.random.key(3), 32))
+    games = [reset(key, params) for key in keys]
+    for t in range(24):
+        actions = np.asarray(jax.random.randint(jax.random.fold_in(jax.random.key(4), t), (32, 2), 0, env.num_actions))
+        games = [step(key, state, action, params)[:2] for key, (_, state), action in zip(keys, games, actions)]
+    obs, state = jax.tree.map(lambda *rows: np.stack(rows), *games)
     return env, obs, state
 
 
@@ -57,19 +54,24 @@ def test_eps1_is_uniform_over_the_legal_actions(two_counters_rom):
     obs, state = env.reset(jax.random.key(0), params)
     legal = jnp.array([True, False, True])  # action 1 closed
     keys = jax.random.split(jax.random.key(1), DRAWS)
-    play = lambda p: jax.jit(jax.vmap(p, in_axes=(None, 0, None, None, None, None)))(  # noqa: E731
-        None, keys, obs[0], state, jnp.int32(0), legal)
-    eps1 = np.asarray(play(make_player("eps1", TWO_COUNTERS)))
+    # eps1 draws its random action with the second half of its key: `same` is `uniform` given those
+    players = {name: make_player(name, TWO_COUNTERS) for name in ("eps1", "eps0.5", "random")}
+    players["same"] = lambda params, key, *rest: uniform(params, jax.random.split(key)[1], *rest)
+
+    @jax.jit  # every player's draws in one program
+    def play(keys, obs, state, legal):
+        return {name: jax.vmap(p, in_axes=(None, 0, None, None, None, None))(None, keys, obs, state, jnp.int32(0), legal)
+                for name, p in players.items()}
+
+    drawn = {name: np.asarray(actions) for name, actions in play(keys, obs[0], state, legal).items()}
+    eps1 = drawn["eps1"]
     counts = np.bincount(eps1, minlength=3) / DRAWS
     assert counts[1] == 0 and abs(counts[0] - 0.5) < 0.04 and abs(counts[2] - 0.5) < 0.04
-    # eps1 draws its random action with the second half of its key: it is `uniform` itself
-    picks = jax.vmap(lambda k: jax.random.split(k)[1])(keys)
-    same = jax.vmap(uniform, in_axes=(None, 0, None, None, None, None))(None, picks, obs[0], state, jnp.int32(0), legal)
-    np.testing.assert_array_equal(eps1, np.asarray(same))
+    np.testing.assert_array_equal(eps1, drawn["same"])
     # eps0.5: the scripted action (2) half the time, else uniform over {0, 2}: 2 three times in four
-    half = np.asarray(play(make_player("eps0.5", TWO_COUNTERS)))
+    half = drawn["eps0.5"]
     assert abs((half == 2).mean() - 0.75) < 0.04 and not (half == 1).any()
-    assert (np.asarray(play(make_player("random", TWO_COUNTERS))) != 1).all()
+    assert (drawn["random"] != 1).all()
 
 
 def test_random_waits_on_the_other_seats_turn(take_turns_rom):

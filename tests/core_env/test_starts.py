@@ -4,6 +4,8 @@ The Ticker test game counts frames in V1, so a reset's state says how many no-op
 started after: V1 = 3 (start-up) + 4 x (no-op steps).
 """
 
+import dataclasses
+
 import jax
 import jax.numpy as jnp
 import numpy as np
@@ -14,6 +16,8 @@ from octax_core.env import starts
 from ticker_game import STARTUP_FRAMES, TICKER, TICKER_ROM
 
 FRAMES = 4
+# The tests of a pool share one env (noop_max=5) and one batch of resets: one compiled reset.
+NOOP_MAX, BATCH = 5, 4000
 
 
 @pytest.fixture(scope="module")
@@ -25,7 +29,7 @@ def ticker_rom(tmp_path_factory):
 
 @pytest.fixture(scope="module")
 def ticker(ticker_rom):
-    """make() plus a jitted batched reset, built once per noop_max."""
+    """make() plus a jitted batched reset, built once per noop_max (and options)."""
     cache = {}
 
     def build(noop_max, **options):
@@ -37,18 +41,26 @@ def ticker(ticker_rom):
     return build
 
 
+@pytest.fixture(scope="module")
+def starts_batch(ticker):
+    """BATCH resets of the noop_max=5 env: its env, params, reset keys, observations and states."""
+    env, params, reset = ticker(NOOP_MAX)
+    keys = jax.random.split(jax.random.key(0), BATCH)
+    return env, params, keys, *reset(keys, params)
+
+
 def noop_counts(states) -> np.ndarray:
     return (np.asarray(states.machine.V[:, 1]).astype(int) - STARTUP_FRAMES) // FRAMES
 
 
-def test_no_op_counts_are_uniform_over_0_to_noop_max(ticker):
-    env, params, reset = ticker(7)
-    _, states = reset(jax.random.split(jax.random.key(0), 4000), params)
+def test_no_op_counts_are_uniform_over_0_to_noop_max(starts_batch):
+    *_, states = starts_batch
     frames = np.asarray(states.machine.V[:, 1]).astype(int)
     assert set((frames - STARTUP_FRAMES) % FRAMES) == {0}  # whole steps only
-    counts = np.bincount(noop_counts(states), minlength=8)
-    assert len(counts) == 8 and counts.min() > 0  # every count 0..7 drawn, none beyond
-    assert counts.min() > 4000 / 8 * 0.8 and counts.max() < 4000 / 8 * 1.2  # uniform (expected 500 each)
+    counts = np.bincount(noop_counts(states), minlength=NOOP_MAX + 1)
+    assert len(counts) == NOOP_MAX + 1 and counts.min() > 0  # every count 0..5 drawn, none beyond
+    expected = BATCH / (NOOP_MAX + 1)  # uniform: about 667 each
+    assert counts.min() > expected * 0.8 and counts.max() < expected * 1.2
 
 
 def test_noop_max_0_starts_every_episode_at_the_template(ticker):
@@ -57,19 +69,18 @@ def test_noop_max_0_starts_every_episode_at_the_template(ticker):
     assert set(noop_counts(states)) == {0}
 
 
-def test_a_start_is_the_template_after_its_no_op_steps_with_a_fresh_seed(ticker):
+def test_a_start_is_the_template_after_its_no_op_steps_with_a_fresh_seed(ticker, starts_batch):
     """The pool's entry for k no-op steps is the state that k real no-op steps reach, except
     its CXNN seed, which each episode draws from its reset key."""
-    env, params, reset = ticker(5)
+    env, params, _, _, states = starts_batch
     alone, _, _ = ticker(0)
     step = jax.jit(alone.step_env)
-    _, states = reset(jax.random.split(jax.random.key(2), 256), params)
     by_count = {}
     for i, k in enumerate(noop_counts(states)):
         by_count.setdefault(int(k), i)
-    assert sorted(by_count) == list(range(6))
+    assert sorted(by_count) == list(range(NOOP_MAX + 1))
     _, walked = alone.reset(jax.random.key(3), params)
-    for k in range(6):
+    for k in range(NOOP_MAX + 1):
         row = jax.tree.map(lambda x: x[by_count[k]], states.machine)
         for name in ("memory", "V", "I", "pc", "sp", "stack", "delay_timer", "sound_timer", "screen", "key_wait"):
             if name == "V":  # V5 holds the pool's last random draw, which the pool's seed decided
@@ -81,11 +92,9 @@ def test_a_start_is_the_template_after_its_no_op_steps_with_a_fresh_seed(ticker)
     assert len(set(rngs.tolist())) == len(rngs)  # every episode its own seed
 
 
-def test_the_same_key_gives_the_same_start_whatever_the_batch(ticker):
-    env, params, reset = ticker(5)
-    keys = jax.random.split(jax.random.key(4), 9)
-    _, batch = reset(keys, params)
-    for i in (0, 4, 8):
+def test_the_same_key_gives_the_same_start_whatever_the_batch(starts_batch):
+    env, params, keys, _, batch = starts_batch
+    for i in (0, 1234, BATCH - 1):
         _, alone = env.reset(keys[i], params)
         for a, b in zip(jax.tree.leaves(alone), jax.tree.leaves(jax.tree.map(lambda x: x[i], batch))):
             np.testing.assert_array_equal(np.asarray(a), np.asarray(b))
@@ -119,27 +128,35 @@ def test_reset_and_autoreset_run_no_loop_whatever_noop_max(ticker, noop_max):
     # the one frame loop (octax_core.emulator.frame): frames, instructions within a frame, and
     # each instruction's memory-write gate (zero trips or one); then the autoreset's gate
     assert _loops(step.jaxpr) == ["while", "scan", "while", "while"]
-    # From 25 instructions a frame skip_idle (the default) runs the same loop over instruction chunks.
-    env, params, _ = ticker(noop_max, autoreset=True, instructions_per_frame=100)
+
+
+def test_the_skip_idle_step_runs_the_same_loops(ticker_rom):
+    """From 25 instructions a frame skip_idle (the default) runs the same loops over instruction
+    chunks. The step's loops do not depend on the starts (the test above), so this env has no
+    no-op starts and no start-up: nothing of its 100-instruction machine is compiled, only traced."""
+    env, params = octax_core.make(dataclasses.replace(TICKER, startup=()), rom=ticker_rom, autoreset=True,
+                                  instructions_per_frame=100)
+    assert env.machine.skip_idle and env.config.noop_max == 0
     _, state = env.reset(jax.random.key(0), params)
     step = jax.make_jaxpr(env.step)(jax.random.key(1), state, 1, params)
     assert _loops(step.jaxpr) == ["while", "scan", "while", "while"]
 
 
-def test_autoreset_restarts_only_the_rows_asked_for(ticker):
-    env, params, reset = ticker(3)
-    keys = jax.random.split(jax.random.key(5), 4)
-    obs, states = reset(keys, params)
-    step = jax.vmap(env.step_env, in_axes=(0, 0, 0, None))
-    obs, states, *_ = step(keys, states, jnp.zeros(4, jnp.int32), params)
-    mask = jnp.array([True, False, True, False])
-    new_obs, new = jax.vmap(env.autoreset, in_axes=(0, 0, 0, 0, None))(keys, mask, obs, states, params)
-    fresh_obs, fresh = jax.vmap(env.reset, in_axes=(0, None))(keys, params)
-    for i in range(4):
-        expect_obs, expect = (fresh_obs, fresh) if mask[i] else (obs, states)
-        np.testing.assert_array_equal(np.asarray(new_obs[i]), np.asarray(expect_obs[i]))
-        for a, b in zip(jax.tree.leaves(new), jax.tree.leaves(expect)):
-            np.testing.assert_array_equal(np.asarray(a[i]), np.asarray(b[i]))
+def test_autoreset_restarts_only_the_rows_asked_for(ticker, starts_batch):
+    """Rows of the batch of starts restarted with other keys: the rows asked for become the new
+    keys' starts (another pool entry and seed), the others stay as they were, bit for bit."""
+    env, params, keys, obs, states = starts_batch
+    _, _, reset = ticker(NOOP_MAX)
+    new_keys = jax.random.split(jax.random.key(5), BATCH)
+    mask = np.arange(BATCH) % 3 == 0
+    new_obs, new = jax.jit(jax.vmap(env.autoreset, in_axes=(0, 0, 0, 0, None)))(new_keys, mask, obs, states, params)
+    fresh_obs, fresh = reset(new_keys, params)
+    assert (noop_counts(fresh) != noop_counts(states)).any()  # the new starts are other starts
+    for got, restarted, kept in zip(jax.tree.leaves((new_obs, new)), jax.tree.leaves((fresh_obs, fresh)),
+                                    jax.tree.leaves((obs, states))):
+        got, restarted, kept = np.asarray(got), np.asarray(restarted), np.asarray(kept)
+        rows = mask.reshape(-1, *[1] * (got.ndim - 1))
+        np.testing.assert_array_equal(got, np.where(rows, restarted, kept))
 
 
 def test_the_pool_has_noop_max_plus_one_counts_of_variants():
