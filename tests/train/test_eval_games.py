@@ -10,33 +10,11 @@ import numpy as np
 import pytest
 
 pytest.importorskip("flax")
-from octax_core.generate import filters, rounds  # noqa: E402
-from octax_core.generate.families import get_family  # noqa: E402
 from octax_gym.cli import main  # noqa: E402
-from octax_gym.cli.generate import write_round  # noqa: E402
 from octax_gym.generated import load_archive  # noqa: E402
 from octax_gym.jax_policy import load_params  # noqa: E402
 from octax_gym.train import preset, resolve_games  # noqa: E402
-from tiny_run import STEPS, TINY  # noqa: E402
-
-COUNT = 6
-
-
-@pytest.fixture(scope="module")
-def archive(tmp_path_factory):
-    """A dodger archive of 6 variants, all accepted (the checks faked, as tests/generate's archive
-    fixture fakes them: their verdicts are not what is tested here)."""
-    folder = tmp_path_factory.mktemp("archive")
-    candidates = rounds.family_candidates(get_family("dodger"), COUNT, 0)
-
-    def fake_check(specs, roms, settings):
-        return [filters.Verdict((), 1.0, 0.5, 3.0) for _ in specs]
-    with pytest.MonkeyPatch.context() as patch:
-        patch.setattr(filters, "check", fake_check)
-        write_round(folder, candidates, filters.Settings(), {"family": "dodger"})
-    train, test = load_archive(folder, "train"), load_archive(folder, "test")
-    assert train and test  # seed 0's six dodgers hold both splits
-    return folder
+from tiny_run import STEPS, TINY, multitask_flags  # noqa: E402
 
 
 def _rows(out):
@@ -54,12 +32,10 @@ def test_archive_names_its_games_and_splits(archive):
         resolve_games("archive::train")
 
 
-def test_multitask_is_evaluated_on_the_held_out_variants(archive, tmp_path):
+def test_multitask_is_evaluated_on_the_held_out_variants(archive, trained):
+    """The multi-task run test_multitask reads too (conftest's `archive`, `tiny_run.multitask_flags`)."""
     train, test = load_archive(archive, "train"), load_archive(archive, "test")
-    out = tmp_path / "run"
-    flags = [*TINY, "--num-envs", str(2 * len(train))]  # lane i plays train variant i mod 3
-    assert main(["train", "multitask", "--games", f"archive:{archive}:train", "--eval-games",
-                 f"archive:{archive}:test", "--no-game-input", "--num-seeds", "2", *flags, "--out-dir", str(out)]) == 0
+    out = trained("multitask", *multitask_flags(archive))  # lane i plays train variant i mod 3
     rows = _rows(out)
     assert list(rows[0])[:4] == ["game", "seed", "split", "step"]
     games = [(s.id, "train") for s in train] + [(s.id, "eval") for s in test]
