@@ -1,7 +1,8 @@
 """Self-play, the trainer's `selfplay` configuration, on the tiny two-player test games
 (tests/two_player_games.py): TwoCounters (simultaneous, with a scripted player) trains a TINY
 run (with a pool, the rate and the entropy weight annealed, evaluated against three rungs);
-TakeTurns (turn-based) checks that the rollout takes its legal masks from the env's state."""
+TakeTurns (turn-based) checks that the rollout takes its legal masks from the env's state, in the
+first rollout of a pool trainer that the pool's checks read too."""
 
 from __future__ import annotations
 
@@ -31,7 +32,8 @@ def tiny(**overrides):
 
 
 # The checks share their programs (compiling them is what this module pays for): one run with a pool
-# and its same-seed repeat (`runs`), one pool trainer's first rollout (`pooled`).
+# and its same-seed repeat (`runs`), one pool trainer's first rollout on the turn-based game
+# (`pooled`: the pool's checks are a seat's, whichever game; the masks' are the turn-based game's).
 POOLED = dict(pool=2, pool_prob=1.0)
 
 
@@ -82,9 +84,12 @@ def test_the_loss_takes_the_updates_entropy_weight_from_the_batch(pooled):
         logits, value = trainer.network.apply(params, obs)
         return masked(logits, legal), value
 
-    loss = jax.jit(lambda minibatch: ppo_loss(after.params, apply, config, minibatch))
-    plain, stats = loss(flat)
-    annealed, _ = loss(flat + (jnp.full(flat[3].shape, 0.004, jnp.float32),))
+    @jax.jit  # both losses in one program
+    def losses(minibatch):
+        return (ppo_loss(after.params, apply, config, minibatch),
+                ppo_loss(after.params, apply, config, minibatch + (jnp.full(minibatch[3].shape, 0.004, jnp.float32),)))
+
+    (plain, stats), (annealed, _) = losses(flat)
     np.testing.assert_allclose(annealed - plain, (config.ent_coef - 0.004) * stats["entropy"], rtol=1e-4)
 
 
@@ -155,10 +160,11 @@ def _collect(config, game, rom):
 
 
 @pytest.fixture(scope="module")
-def pooled(two_counters_rom):
-    """A pool trainer (2 past selves, one on a seat of every env), its first runner and its first rollout."""
-    config = tiny(**POOLED)
-    return (config, *_collect(config, TWO_COUNTERS, two_counters_rom))
+def pooled(take_turns_rom):
+    """A pool trainer of TakeTurns (2 past selves, one on a seat of every env), its first runner and
+    its first rollout."""
+    config = dataclasses.replace(tiny(**POOLED), games=(TAKE_TURNS,))
+    return (config, *_collect(config, TAKE_TURNS, take_turns_rom))
 
 
 def test_a_past_self_plays_one_seat_of_an_env_and_its_samples_weigh_zero(pooled):
@@ -175,7 +181,7 @@ def test_a_past_self_plays_one_seat_of_an_env_and_its_samples_weigh_zero(pooled)
     flat = jax.tree.map(lambda x: x.reshape((-1,) + x.shape[2:]), batch)
     changed = list(flat)
     zero = flat[-1] == 0
-    changed[3] = jnp.where(zero, (flat[3] + 1) % 3, flat[3])  # actions
+    changed[3] = jnp.where(zero, 1 - flat[3], flat[3])  # actions (TakeTurns': no-op and its key)
     changed[6] = jnp.where(zero, flat[6] + 100.0, flat[6])  # advantages
 
     def apply(params, obs, game, legal):
@@ -204,11 +210,10 @@ def test_the_pool_takes_a_snapshot_at_each_evaluations_update(pooled):
     np.testing.assert_allclose(leaf(runner.pool.params)[1], base + 3, rtol=1e-6)
 
 
-def test_turn_based_legal_masks_come_from_the_state_and_are_honoured(take_turns_rom):
-    config = dataclasses.replace(tiny(), games=(TAKE_TURNS,))
-    lanes, _, runner, (_, batch, _) = _collect(config, TAKE_TURNS, take_turns_rom)
+def test_turn_based_legal_masks_come_from_the_state_and_are_honoured(pooled):
+    config, lanes, _, runner, (_, batch, _) = pooled
     legal, action = np.asarray(batch[2]), np.asarray(batch[3])  # (T, 2N, ACTIONS), (T, 2N)
-    assert np.take_along_axis(legal, action[..., None], -1).all()  # never a closed action
+    assert np.take_along_axis(legal, action[..., None], -1).all()  # never a closed action (the past self's neither)
     per_env = legal.reshape(config.num_steps, config.num_envs, 2, -1)
     # one seat moves: it has its key (action 1), the other no-op alone; actions past the game's 2 never
     assert (per_env[..., 1].sum(-1) == 1).all() and not per_env[..., 2:].any()
