@@ -1,6 +1,8 @@
 """One machine for three platforms: the gated work (`gate.when_any`), the two display surfaces,
 and a CHIP-8 program run alike by the chip8, schip and xochip machines."""
 
+import functools
+
 import jax
 import jax.numpy as jnp
 import numpy as np
@@ -111,6 +113,19 @@ def test_a_sprite_on_both_surfaces_is_the_same_picture(clipping):
 PONG = "Pong (1 player).ch8"
 
 
+def pong_machine(platform: str) -> octax_core.Machine:
+    return octax_core.Machine(platform, quirks="chip8", instructions_per_frame=11)
+
+
+@functools.lru_cache(maxsize=None)
+def pong_program(machine: octax_core.Machine):
+    """8 machines, 300 recorded frames, with the platform's compiler options (exact: see
+    test_compiler_options.py): the program the Pong test runs and the copy test reads, one
+    compile for both."""
+    return jax.jit(jax.vmap(lambda s, k: machine.run_frames(s, k, 300, record_screens=True)),
+                   compiler_options=machine.compiler_options)
+
+
 @pytest.fixture(scope="module")
 def pong_runs(octax_rom_dir):
     """Pong, 11 instructions a frame, the chip8 quirks, 8 machines with random keys, 300 frames,
@@ -119,10 +134,9 @@ def pong_runs(octax_rom_dir):
     keys = jax.random.randint(jax.random.key(1), (8,), 0, 1 << 16).astype(jnp.uint32) & 0x1012
     out = {}
     for platform in ("chip8", "schip", "xochip"):
-        machine = octax_core.Machine(platform, quirks="chip8", instructions_per_frame=11)
+        machine = pong_machine(platform)
         boot = jax.vmap(lambda k: machine.boot(rom, k))(jax.random.split(jax.random.key(0), 8))
-        run = jax.jit(jax.vmap(lambda s, k: machine.run_frames(s, k, 300, record_screens=True)))
-        out[platform] = run(boot, keys)
+        out[platform] = pong_program(machine)(boot, keys)
     return out
 
 
@@ -159,16 +173,22 @@ def _xochip_drawing(planes: int, hires: bool) -> bytes:
     return code.ljust(0x20, b"\0") + sprite
 
 
-def test_plane_2_is_drawn_where_a_machine_asks_in_any_batch(jit_run_frames):
+def test_plane_2_is_drawn_where_a_machine_asks_in_any_batch(jit_run_frames, jit_batch_run_frames):
     """XO-CHIP's plane 2 on the 64x32 screen is gated work (`cpu._draw_second_plane`): in a batch
     where machines draw on plane 1, plane 2, both, none, or in hires, each machine's screen, grid
-    and collisions are its own run alone, and a batch where no machine asks leaves plane 2 dark."""
+    and collisions are its own run alone, and a batch where no machine asks leaves plane 2 dark.
+    (The machine, batch size and frame count are test_platforms.py's batch test's: one compile
+    of each program for both.)"""
     machine = octax_core.Machine("xochip", instructions_per_frame=30)
     cases = [(1, False), (2, False), (3, False), (0, False), (3, True), (2, True)]
     states = [machine.boot(_xochip_drawing(planes, hires), jax.random.key(i)) for i, (planes, hires) in enumerate(cases)]
     alone = [jit_run_frames(machine)(state, 0, 1) for state in states]  # one compile for the six
     batch = jax.tree.map(lambda *leaves: jnp.stack(leaves), *states)
-    run = jax.jit(jax.vmap(lambda s: machine.run_frames(s, 0, 1)))
+    no_keys = jnp.zeros(len(cases), jnp.uint32)
+
+    def run(batch):
+        return jit_batch_run_frames(machine, 1)(batch, no_keys)
+
     together = run(batch)
     for m, ((planes, hires), one) in enumerate(zip(cases, alone)):
         for path, leaf, expected in zip(jax.tree_util.tree_flatten_with_path(one)[0], jax.tree.leaves(together),
@@ -208,10 +228,11 @@ def test_the_frame_loop_is_the_only_loop(monkeypatch):
 
 
 def test_shown_is_the_picture_of_the_mode(jit_run_frames):
-    machine = octax_core.Machine("schip", instructions_per_frame=20)
+    # (the one-frame program of test_platforms.py's exit tests, called alike: one compile for all)
+    machine = octax_core.Machine("schip", instructions_per_frame=5)
     # hires; draw the 8x1 sprite 0xFF at (0, 0); loop
     program = bytes([0x00, 0xFF, 0xA2, 0x08, 0xD0, 0x01, 0x12, 0x06, 0xFF])
-    state = jit_run_frames(machine)(machine.boot(program, jax.random.key(0)), 0, 1)
+    state = jit_run_frames(machine)(machine.boot(program, jax.random.key(0)), jnp.uint32(0), 1, halted=jnp.bool_(False))
     assert bool(state.extension.hires) and not np.asarray(state.screen).any()
     np.testing.assert_array_equal(np.asarray(shown(state)), np.asarray(state.extension.grid))
     assert octax_core.render_text(state).splitlines()[0][:9] == "########."
@@ -382,15 +403,17 @@ def test_the_instruction_loop_copies_no_screen(name):
     (a scroll reads the surface it rewrites) may copy. CHIP-8 is left out: jitted like this,
     without the benchmarks' scan around it, XLA copies its drawn screen once an instruction.
     Reading its collision off the drawn screen instead removes that copy, but ran 15% slower on
-    a 15-ipf program at N = 512 in the scan, where XLA copies nothing either way (docs/machine.md)."""
+    a 15-ipf program at N = 512 in the scan, where XLA copies nothing either way (docs/machine.md).
+    The program read is the Pong test's (8 machines, 300 recorded frames, the platform's options):
+    on a CPU host its compile is shared."""
     import re
 
-    machine = octax_core.Machine(name, quirks="chip8", instructions_per_frame=11)
+    machine = pong_machine(name)
     states = jax.vmap(lambda k: machine.boot(b"\x00\xe0\x12\x00", k))(jax.random.split(jax.random.key(0), 8))
-    host = jax.devices("cpu")[0]  # XLA:CPU's program, also on a host with an accelerator
-    states, keys = jax.device_put((states, jnp.zeros(8, jnp.uint32)), host)
-    run = jax.jit(jax.vmap(lambda s, k: machine.run_frames(s, k, 4)), compiler_options=machine.compiler_options)
-    text = run.lower(states, keys).compile().as_text()
+    keys = jnp.zeros(8, jnp.uint32)
+    if jax.default_backend() != "cpu":  # XLA:CPU's program, also on a host with an accelerator
+        states, keys = jax.device_put((states, keys), jax.devices("cpu")[0])  # (placed arrays: a compile of its own)
+    text = pong_program(machine).lower(states, keys).compile().as_text()
     screen = re.escape("u32[" + ",".join(map(str, states.screen.shape)) + "]")
     looping = {body: code for body, code in _loop_bodies(text).items() if " while(" in code}
     assert looping  # the frame loop and the instruction loop at least

@@ -230,17 +230,24 @@ def test_exit_stands_still_and_an_env_can_read_it(jit_run_frames):
     assert all(np.array_equal(a, b) for a, b in zip(jax.tree.leaves(state), jax.tree.leaves(later)))
 
 
-def test_batches_run_each_machine_as_alone(jit_run_frames):
+def test_batches_run_each_machine_as_alone(jit_run_frames, jit_batch_run_frames):
     # random sprites and scrolls; the same key gives the same machine whatever the batch
+    # (4 one-frame calls of 6 machines: test_one_machine.py's plane-2 test's programs, one compile for both)
     rom = assemble(0x00FF, 0xF301, 0xC0FF, 0xC1FF, 0xA200, 0xD010, 0x00C1, 0x00FB, 0x1204)
-    machine = octax_core.Machine("xochip", instructions_per_frame=20)
-    keys = jax.random.split(jax.random.key(7), 3)
-    batch = jax.jit(jax.vmap(lambda k: machine.run_frames(machine.boot(rom, k), 0, 6)))(keys)
-    for i in range(3):
-        alone = jit_run_frames(machine)(machine.boot(rom, keys[i]), 0, 6)
+    machine = octax_core.Machine("xochip", instructions_per_frame=30)
+    keys = jax.random.split(jax.random.key(7), 6)
+    boots = [machine.boot(rom, k) for k in keys]
+    batch = jax.tree.map(lambda *leaves: jnp.stack(leaves), *boots)
+    for _ in range(4):
+        batch = jit_batch_run_frames(machine, 1)(batch, jnp.zeros(6, jnp.uint32))
+    for i in range(6):
+        alone = boots[i]
+        for _ in range(4):
+            alone = jit_run_frames(machine)(alone, 0, 1)
         for a, b in zip(jax.tree.leaves(alone), jax.tree.leaves(batch)):
             assert np.array_equal(np.asarray(a), np.asarray(b)[i])
-    assert octax_core.snapshot(batch)["screen"].shape == (3, 2, 64, 128)
+    assert octax_core.snapshot(batch)["screen"].shape == (6, 2, 64, 128)
+    assert len({bytes(np.asarray(grid)) for grid in batch.extension.grid}) > 1  # each key drew its own (hires) picture
 
 
 def test_record_screens_has_the_platform_shape():
