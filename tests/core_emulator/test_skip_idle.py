@@ -4,7 +4,7 @@ Each example is a batch of three different programs (their states stacked, so ev
 batch runs its own code, as envs of different episodes do), built from blocks that spin in the
 ways real games wait: on the delay timer, on a key held or not held, in FX0A, on a jump to itself,
 and a counter loop that ends. Between the waits come register work, draws, stores, random numbers
-and (on SUPER-CHIP and XO-CHIP) mode switches, scrolls, planes and long I loads, so a spin may
+and (on XO-CHIP, SUPER-CHIP's opcodes included) mode switches, scrolls, planes and long I loads, so a spin may
 start anywhere in a frame and the detector must restart after every write. Both machines run the
 same calls with the same keys; every field of every state and every recorded screen must match.
 """
@@ -17,10 +17,12 @@ import numpy as np
 import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
+from reference import RefMachine, first_difference
 
 import octax_core
 from octax_core.emulator import idle
 from octax_core.emulator.opcodes import Kind
+from octax_core.emulator.state import shown
 
 PROGRAM_START = 0x200
 BATCH = 3
@@ -28,11 +30,14 @@ CALLS = 5  # run_frames calls per example, each with its own keys
 FRAMES_PER_CALL = 2
 SETTINGS = settings(max_examples=25, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 
+# Each machine is two compiled programs (skipping and plain), so the property runs on the two
+# most distinct: the VIP's CHIP-8, where a draw ends the frame (display wait) 40 instructions in,
+# and XO-CHIP at 300 instructions a frame without display wait, whose programs also take every
+# SUPER-CHIP block (mode switches, scrolls, 16x16 sprites, flags) and its own (planes, long I, 64
+# KiB). A SUPER-CHIP machine and a fast CHIP-8 one sit between the two; the archive programs
+# (test_archive_platforms.py) run idle skipping on SUPER-CHIP against the reference.
 MACHINES = {
-    # the VIP profile: DXYN ends the frame (display wait), 40 instructions a frame
     "chip8-vip": dict(platform="chip8", quirks="chip8", instructions_per_frame=40),
-    "chip8-fast": dict(platform="chip8", quirks="schip", instructions_per_frame=200),
-    "schip": dict(platform="schip", instructions_per_frame=100),
     "xochip": dict(platform="xochip", instructions_per_frame=300),
 }
 
@@ -129,7 +134,7 @@ xochip_blocks = [
 
 
 def blocks_for(name):
-    extra = {"schip": extended_blocks, "xochip": extended_blocks + xochip_blocks}.get(name, [])
+    extra = extended_blocks + xochip_blocks if MACHINES[name]["platform"] == "xochip" else []
     return st.lists(st.one_of(*common_blocks, *extra), min_size=1, max_size=8)
 
 
@@ -183,16 +188,27 @@ def test_wait_loops_run_bit_identically_with_skip_idle(name):
     check()
 
 
-def test_a_spin_is_skipped_to_the_exact_position_the_frame_would_end_at():
+def test_a_spin_is_skipped_to_the_exact_position_the_frame_would_end_at(jit_run_frames):
     """A 3-instruction delay-timer spin entered mid-frame ends the frame at the pc, and with the
-    register values, that running every instruction gives, for frame lengths of every residue."""
+    register values, that running every instruction gives, for frame lengths of every residue
+    and chunk (the frame divided into chunks of 5, 13 and 10; a last partial chunk at 37 and 997).
+    Running every instruction is tests/reference.py's interpreter here, frame by frame (the
+    whole snapshot: every field of a CHIP-8 state), so each length compiles one program, not two."""
     rom = assemble([set_delay(1, 5), delay_wait(2)], [])
+    ends = set()
     for ipf in (idle.SKIP_FROM, 26, 37, 100, 997):
         fast = octax_core.Machine("chip8", instructions_per_frame=ipf, skip_idle=True)
-        slow = octax_core.Machine("chip8", instructions_per_frame=ipf, skip_idle=False)
-        a = fast.run_frames(fast.boot(rom, jax.random.key(0)), 0, 3)
-        b = slow.run_frames(slow.boot(rom, jax.random.key(0)), 0, 3)
-        assert first_mismatch(a, b) is None, ipf
+        assert fast.skipping
+        state = fast.boot(rom, jax.random.key(0))
+        ref = RefMachine(rom, fast.quirks, ipf, rng=int(octax_core.snapshot(state)["rng"]))
+        for frame in range(3):
+            state = jit_run_frames(fast)(state, 0, 1)
+            ref.run_frame(0)
+            difference = first_difference(ref.snapshot(), octax_core.snapshot(state))
+            assert difference is None, (ipf, frame, difference)
+            ends.add(ref.pc)
+        assert ref.delay_timer == 2  # still spinning at the third frame's end
+    assert ends == {PROGRAM_START + 4, PROGRAM_START + 6, PROGRAM_START + 8}  # frames end at each of the spin's 3 instructions
 
 
 def test_pure_kinds_are_the_ones_that_write_no_memory_and_no_screen():
@@ -209,21 +225,25 @@ def test_skip_idle_is_checked():
         octax_core.Machine("chip8", skip_idle="yes")
 
 
-def test_nested_vmap_and_a_single_machine_agree_with_the_plain_loop():
+def test_nested_vmap_and_a_single_machine_agree_with_the_plain_loop(jit_run_frames):
     """The batching rule serves one vmap; an outer one (seeds x envs) batches what it returns, and a
     machine outside any vmap runs the unbatched loop: all three give the plain loop's states."""
     rom = assemble([set_delay(1, 3), delay_wait(2), draw(0, 1, 5, 7), key_spin(3, 5, False)], [0x6A07])
-    fast = octax_core.Machine("chip8", instructions_per_frame=50, skip_idle=True)
-    slow = octax_core.Machine("chip8", instructions_per_frame=50, skip_idle=False)
+    # (100 instructions a frame: the single machine runs the spin test's one-frame program)
+    fast = octax_core.Machine("chip8", instructions_per_frame=100, skip_idle=True)
+    slow = octax_core.Machine("chip8", instructions_per_frame=100, skip_idle=False)
     keys = np.array([[0, 1 << 5], [1 << 5, 0]], np.uint32)
     seeds = jax.random.split(jax.random.key(1), 4).reshape(2, 2)
     states = jax.vmap(jax.vmap(lambda k: slow.boot(rom, k)))(seeds)
     run = lambda m: jax.jit(jax.vmap(jax.vmap(lambda s, k: m.run_frames(s, k, 3, record_screens=True))))
     a, b = run(fast)(states, keys), run(slow)(states, keys)
     assert first_mismatch(a, b) is None
-    single = jax.tree.map(lambda leaf: leaf[1, 0], states)
-    one = fast.run_frames(single, keys[1, 0], 3, record_screens=True)
-    assert first_mismatch(one, jax.tree.map(lambda leaf: leaf[1, 0], b)) is None
+    one = jax.tree.map(lambda leaf: leaf[1, 0], states)
+    plain_state, plain_screens = jax.tree.map(lambda leaf: leaf[1, 0], b)
+    for frame in range(3):
+        one = jit_run_frames(fast)(one, int(keys[1, 0]), 1)
+        assert np.array_equal(np.asarray(shown(one)), np.asarray(plain_screens[frame])), frame
+    assert first_mismatch(one, plain_state) is None
 
 
 def test_chunk_size_wastes_little_of_a_busy_frame():
