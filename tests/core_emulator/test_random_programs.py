@@ -7,10 +7,8 @@ random keys, and the whole snapshot must match after every instruction; a second
 runs whole frames. Three quirk sets: the two profiles and a mix that neither covers (sprites wrap).
 """
 
-import functools
 
 import jax
-import numpy as np
 import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
@@ -39,17 +37,6 @@ def fast_and_full(test, parametrize):
     examples, and SETTINGS's count marked slow."""
     fast = parametrize(settings(SETTINGS, max_examples=FAST_EXAMPLES)(test()))
     return fast, pytest.mark.slow(parametrize(SETTINGS(test())))
-
-
-@functools.lru_cache(maxsize=None)
-def jitted_trace(machine):
-    """(state, keys[STEPS]) -> the STEPS states after each instruction, stacked."""
-    def trace(state, keys):
-        def step(state, keys):
-            state = machine.execute(state, keys)
-            return state, state
-        return jax.lax.scan(step, state, keys)[1]
-    return jax.jit(trace)
 
 
 # ---- programs ------------------------------------------------------------------------------------
@@ -126,9 +113,9 @@ def boot_both(rom, quirks, seed):
 def instructions_property():
     @given(rom=programs(), keys=st.lists(key_mask, min_size=STEPS, max_size=STEPS),
            seed=st.integers(0, 2**32 - 1))
-    def test_instructions_match_reference(quirk_set, rom, keys, seed):
+    def test_instructions_match_reference(quirk_set, rom, keys, seed, jit_execute):
         machine, state, ref = boot_both(rom, QUIRK_SETS[quirk_set], seed)
-        assert_instructions_match(quirk_set, machine, state, ref, keys, rom)
+        assert_instructions_match(quirk_set, jit_execute(machine), state, ref, keys, rom)
     return test_instructions_match_reference
 
 
@@ -136,14 +123,15 @@ test_instructions_match_reference, test_instructions_match_reference_all_example
     instructions_property, pytest.mark.parametrize("quirk_set", QUIRK_SETS))
 
 
-def assert_instructions_match(label, machine, state, ref, keys, rom):
-    """Runs one instruction per key mask on both machines; every snapshot must match."""
-    states = octax_core.snapshot(jitted_trace(machine)(state, np.asarray(keys, np.int32)))
+def assert_instructions_match(label, execute, state, ref, keys, rom):
+    """Runs one instruction per key mask on both machines; every snapshot must match. `execute`
+    is the session's jitted `machine.execute` (tests/conftest.py), the program the per-opcode
+    tests and the hand programs run: one compile per machine for all of them."""
     for step, mask in enumerate(keys):
         pc = ref.pc
         opcode = ref.execute(mask)
-        got = {name: value[step] for name, value in states.items()}
-        difference = first_difference(ref.snapshot(), got)
+        state = execute(state, mask)
+        difference = first_difference(ref.snapshot(), octax_core.snapshot(state))
         assert difference is None, (
             f"[{label}] instruction {step}, pc={pc:#06x} opcode={opcode:04X}, keys={mask:#06x}: "
             f"{difference}\n  program: {listing(rom)}")

@@ -28,7 +28,7 @@ CASES = {
 }
 STEPS = 96
 FRAMES = 4
-INSTRUCTIONS_PER_FRAME = 11
+INSTRUCTIONS_PER_FRAME = 11  # test_reference_platforms.py runs its ROMs on these machines too (one compile)
 PROGRAM_START = 0x200
 SETTINGS = settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 FAST_EXAMPLES = 20  # in make test; make test-slow runs SETTINGS's count too (the `_all_examples` twins)
@@ -96,10 +96,10 @@ def case_programs(case):
 
 def instructions_property():
     @given(data=st.data(), keys=st.lists(key_mask, min_size=STEPS, max_size=STEPS), seed=st.integers(0, 2**32 - 1))
-    def test_instructions_match_reference(case, data, keys, seed):
+    def test_instructions_match_reference(case, data, keys, seed, jit_execute):
         rom = data.draw(case_programs(case), label="rom")
         machine, state, ref = boot_both(rom, case, seed)
-        assert_instructions_match(case, machine, state, ref, keys, rom)
+        assert_instructions_match(case, jit_execute(machine), state, ref, keys, rom)
     return test_instructions_match_reference
 
 

@@ -204,13 +204,16 @@ class SuiteRun:
             import octax_core
             machine = octax_core.Machine(platform, instructions_per_frame=ipf)
             self.state = octax_core.poke(machine.boot(data, jax.random.key(0)), 0x1FF, bytes([mode]))
-            self.run = jit_run_frames(machine)  # shared by the modes of a platform: one compile
+            # one frame a call: the program of a platform's every mode and ROM here, and of
+            # test_random_programs_platforms.py's frame property (same machine): one compile
+            self.run = jit_run_frames(machine)
 
     def frames(self, count):
         if self.impl == "reference":
             self.ref.run_frames(0, count)
         else:
-            self.state = self.run(self.state, 0, count)
+            for _ in range(count):
+                self.state = self.run(self.state, 0, 1)
 
     def screen(self):
         """Plane 1's visible screen in screen pixels: 64x32 in lores (each a uniform 2x2 block)."""
@@ -227,13 +230,16 @@ class SuiteRun:
 
 
 IMPLEMENTATIONS = ("reference", "core")
+# Both ROMs at the random-program tests' speed (their machines and frame program are these), in
+# 1-frame calls: the 5-quirks verdicts settle within 300 frames, the arrows within 60.
+IPF = 11
 
 
 @pytest.mark.shared
 @pytest.mark.parametrize("impl", IMPLEMENTATIONS)
 @pytest.mark.parametrize("mode, platform", [(2, "schip"), (3, "xochip")])
 def test_quirks_rom_passes_every_quirk(mode, platform, impl, jit_run_frames):
-    run = SuiteRun(impl, "5-quirks", mode, platform, 30, jit_run_frames)
+    run = SuiteRun(impl, "5-quirks", mode, platform, IPF, jit_run_frames)
     for _ in range(15 * 6):
         run.frames(10)
         if st.mark_at(run.screen(), 59, 27, FLAG_OK, FLAG_ERR) != "missing":
@@ -281,7 +287,7 @@ def border_pixels(mode):
 @pytest.mark.parametrize("mode, platform", [(1, "schip"), (3, "schip"), (4, "xochip"), (5, "xochip")])
 def test_scrolling_rom_puts_every_arrow_in_a_box(mode, platform, impl, jit_run_frames):
     source = (st.SUITE / "8-scrolling.8o").read_text()
-    run = SuiteRun(impl, "8-scrolling", mode, platform, 100, jit_run_frames)
+    run = SuiteRun(impl, "8-scrolling", mode, platform, IPF, jit_run_frames)
     run.frames(120)
     screen = run.screen()
     on = {(x, y) for y, x in zip(*np.nonzero(screen))}
