@@ -57,10 +57,10 @@ class Chip:
         return self
 
     def frames(self, n, keys=0):
-        """Runs n frames, in calls of 60 and 1 frames (so a config compiles at most twice)."""
-        for size in (60, 1):
-            while n >= size:
-                self.state, n = self._jit[1](self.machine)(self.state, keys, size), n - size
+        """Runs n frames, one a call: a config compiles once, and the default configs' program
+        is the one test_differential.py and test_vmap.py run."""
+        for _ in range(n):
+            self.state = self._jit[1](self.machine)(self.state, keys, 1)
         return self
 
     def snapshot(self):

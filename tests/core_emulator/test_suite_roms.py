@@ -30,13 +30,15 @@ IPF = 11
 
 @pytest.fixture(scope="module")
 def run(jit_run_frames, test_suite_dir):
-    """run(machine, state, keys=0, seconds=1) -> state, via the session's jitted run_frames."""
+    """run(machine, state, keys=0, seconds=1) -> state, via the session's jitted run_frames, one
+    frame a call: the program test_differential.py and the per-opcode tests run on the same
+    machines, one compile for all."""
     assert test_suite_dir.resolve() == SUITE.resolve()
 
     def run(machine, state, keys=0, seconds=1):
         fn = jit_run_frames(machine)
-        for _ in range(seconds):
-            state = fn(state, keys, SECOND)
+        for _ in range(seconds * SECOND):
+            state = fn(state, keys, 1)
         return state
 
     return run

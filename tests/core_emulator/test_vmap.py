@@ -66,11 +66,12 @@ def test_batched_equals_single(rom_path, profile, jit_run_frames):
     rngs = octax_core.snapshot(batch)["rng"]
     assert len(set(rngs.tolist())) == BATCH, "boot keys should give different rng states"
 
-    run_single = jit_run_frames(machine)
+    run_single = jit_run_frames(machine)  # one frame a call: test_differential.py's program, one compile for both
     run_batch = jitted_batched_run(machine, FRAMES_PER_CALL)
     for call, masks in enumerate(key_masks(zlib.crc32(rom_path.name.encode()))):
         batch = run_batch(batch, as_bools(masks))
-        singles = [run_single(state, mask, FRAMES_PER_CALL) for state, mask in zip(singles, masks)]
+        for _ in range(FRAMES_PER_CALL):
+            singles = [run_single(state, mask, 1) for state, mask in zip(singles, masks)]
         batch_snap = octax_core.snapshot(batch)
         for env, state in enumerate(singles):
             difference = first_difference(octax_core.snapshot(state), unbatch(batch_snap, env))
