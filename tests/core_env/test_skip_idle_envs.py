@@ -24,37 +24,43 @@ FAST_GAMES = ["Pong", "DodgeArchive", "OctoPartyMix"]
 SLOW_GAMES = [g for g in octax_core.list_games() if g not in FAST_GAMES]
 
 
-# Two entries: a test's two rollouts (skip_idle on and off). Keeping every game's compiled programs
-# alive through the whole-registry slow test grew a worker past what CI's machine holds.
-@functools.lru_cache(maxsize=2)
-def rollout(game: str, skip_idle: bool):
+def make_env(game: str, skip_idle: bool):
     own = make_config(octax_core.get_spec(game))[0].instructions_per_frame
     ipf = own if own >= idle.SKIP_FROM else 4 * own
-    env, params = octax_core.make(game, autoreset=True, skip_idle=skip_idle, instructions_per_frame=ipf)
+    return octax_core.make(game, autoreset=True, skip_idle=skip_idle, instructions_per_frame=ipf)
 
-    def run(key, actions):
-        obs, state = jax.vmap(env.reset, in_axes=(0, None))(jax.random.split(key, NUM_ENVS), params)
 
-        def step(carry, inputs):
-            state, = carry
-            keys, action = inputs
-            out = jax.vmap(env.step, in_axes=(0, 0, 0, None))(keys, state, action, params)
-            obs, state, reward, terminated, truncated, info = out
-            return (state,), (obs, reward, terminated, truncated, info)
+def rollout(env, params, key, actions):
+    """NUM_ENVS envs reset from `key`, then STEPS steps of `actions`: first obs, trajectory, final state."""
+    obs, state = jax.vmap(env.reset, in_axes=(0, None))(jax.random.split(key, NUM_ENVS), params)
 
-        keys = jax.random.split(jax.random.fold_in(key, 1), (STEPS, NUM_ENVS))
-        (state,), trajectory = jax.lax.scan(step, (state,), (keys, actions))
-        return obs, trajectory, state
+    def step(carry, inputs):
+        state, = carry
+        keys, action = inputs
+        out = jax.vmap(env.step, in_axes=(0, 0, 0, None))(keys, state, action, params)
+        obs, state, reward, terminated, truncated, info = out
+        return (state,), (obs, reward, terminated, truncated, info)
 
-    return env, jax.jit(run)
+    keys = jax.random.split(jax.random.fold_in(key, 1), (STEPS, NUM_ENVS))
+    (state,), trajectory = jax.lax.scan(step, (state,), (keys, actions))
+    return obs, trajectory, state
+
+
+# One entry: a game's two rollouts, skip_idle on and off, are one compiled program (a compile
+# per game, not two). Keeping every game's programs alive through the whole-registry slow test
+# grew a worker past what CI's machine holds.
+@functools.lru_cache(maxsize=1)
+def rollouts(game: str):
+    """The game's envs with skip_idle on and off, and both rollouts of a key and actions, jitted as one."""
+    fast, slow = make_env(game, True), make_env(game, False)
+    return fast[0], slow[0], jax.jit(lambda key, actions: (rollout(*fast, key, actions), rollout(*slow, key, actions)))
 
 
 def check_same_trajectory(game: str):
-    env, fast = rollout(game, True)
-    _, slow = rollout(game, False)
+    env, plain, both = rollouts(game)
+    assert env.machine.skip_idle and not plain.machine.skip_idle
     actions = np.random.default_rng(7).integers(0, env.num_actions, (STEPS, NUM_ENVS), dtype=np.int32)
-    key = jax.random.key(3)
-    a, b = fast(key, actions), slow(key, actions)
+    a, b = both(jax.random.key(3), actions)
     names = ["reset obs", "obs", "reward", "terminated", "truncated", "info", "final state"]
     for name, x, y in zip(names, [a[0], *a[1], a[2]], [b[0], *b[1], b[2]]):
         for (path, p), q in zip(jax.tree_util.tree_flatten_with_path(x)[0], jax.tree.leaves(y)):
