@@ -236,12 +236,11 @@ def test_batches_run_each_machine_as_alone(jit_run_frames, jit_batch_run_frames)
     rom = assemble(0x00FF, 0xF301, 0xC0FF, 0xC1FF, 0xA200, 0xD010, 0x00C1, 0x00FB, 0x1204)
     machine = octax_core.Machine("xochip", instructions_per_frame=30)
     keys = jax.random.split(jax.random.key(7), 6)
-    boots = [machine.boot(rom, k) for k in keys]
-    batch = jax.tree.map(lambda *leaves: jnp.stack(leaves), *boots)
+    batch = jax.vmap(lambda k: machine.boot(rom, k))(keys)
     for _ in range(4):
         batch = jit_batch_run_frames(machine, 1)(batch, jnp.zeros(6, jnp.uint32))
     for i in range(6):
-        alone = boots[i]
+        alone = machine.boot(rom, keys[i])
         for _ in range(4):
             alone = jit_run_frames(machine)(alone, 0, 1)
         for a, b in zip(jax.tree.leaves(alone), jax.tree.leaves(batch)):

@@ -7,7 +7,6 @@ random keys, and the whole snapshot must match after every instruction; a second
 runs whole frames. Three quirk sets: the two profiles and a mix that neither covers (sprites wrap).
 """
 
-
 import jax
 import pytest
 from hypothesis import HealthCheck, given, settings

@@ -4,9 +4,10 @@ Each example is a batch of three different programs (their states stacked, so ev
 batch runs its own code, as envs of different episodes do), built from blocks that spin in the
 ways real games wait: on the delay timer, on a key held or not held, in FX0A, on a jump to itself,
 and a counter loop that ends. Between the waits come register work, draws, stores, random numbers
-and (on XO-CHIP, SUPER-CHIP's opcodes included) mode switches, scrolls, planes and long I loads, so a spin may
-start anywhere in a frame and the detector must restart after every write. Both machines run the
-same calls with the same keys; every field of every state and every recorded screen must match.
+and (on XO-CHIP, SUPER-CHIP's opcodes included) mode switches, scrolls, planes and long I loads,
+so a spin may start anywhere in a frame and the detector must restart after every write. Both
+machines run the same calls with the same keys; every field of every state and every recorded
+screen must match.
 """
 
 import functools
