@@ -176,10 +176,11 @@ def test_autoreset_starts_a_new_episode_for_both_seats(counters):
 
 
 def test_sticky_actions_are_per_seat(counters):
-    _, _, _, path = counters
+    _, _, step, path = counters  # the sticky probability is a param: the fixture's compiled step plays it
     env, params = octax_core.make_multi(TWO_COUNTERS, rom=path, repeat_action_probability=1.0)
+    assert env.config == counters[0].config
     _, state = env.reset(jax.random.key(0), params)
-    _, state, reward, *_ = env.step(jax.random.key(0), state, jnp.array([1, 2]), params)
+    _, state, reward, *_ = step(jax.random.key(0), state, jnp.array([1, 2]), params)
     np.testing.assert_array_equal(reward, [0.0, 0.0])  # both repeat their first action, no-op
     assert state.last_action.shape == (2,)
 
