@@ -16,11 +16,11 @@ import pytest
 
 pytest.importorskip("flax")
 from octax_gym.cli import main  # noqa: E402
+from octax_gym.generated import load_archive  # noqa: E402
 from octax_gym.jax_policy import describe, load_params  # noqa: E402
 from octax_gym.train import preset  # noqa: E402
 from octax_gym.train.algorithm import make_trainer  # noqa: E402
 from octax_gym.train.envs import Lanes  # noqa: E402
-from octax_gym.generated import load_archive  # noqa: E402
 from tiny_run import multitask_flags  # noqa: E402
 
 
