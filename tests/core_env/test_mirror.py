@@ -31,7 +31,7 @@ def mirrored_play(cycles):
         rows = []
         for i, key in enumerate(jax.random.split(jax.random.key(100 + t), N)):
             obs, states[i], rewards, *_ = step(key, states[i], same_action(states[i].machine), params)
-            rows.append((np.asarray(obs), np.asarray(rewards), np.asarray(states[i].machine.V[3])))
+            rows.append((np.asarray(obs), np.asarray(rewards), np.asarray(states[i].machine.V)[3]))
         steps.append(tuple(np.stack(column) for column in zip(*rows)))
     return steps
 

@@ -7,7 +7,6 @@ started after: V1 = 3 (start-up) + 4 x (no-op steps).
 import dataclasses
 
 import jax
-import jax.numpy as jnp
 import numpy as np
 import pytest
 
