@@ -99,15 +99,18 @@ def test_patches_are_the_strided_slices_bit_for_bit_both_ways(x_shape, kernel_si
 
 
 def test_masked_actions_are_never_chosen_and_cost_no_entropy():
-    legal = legal_actions(3)
-    logits = jnp.zeros((4000, ACTIONS)).at[:, 10].set(5.0)  # an illegal favourite
-    sample = jax.random.categorical(jax.random.key(0), masked(logits, legal))
+    @jax.jit  # the sample, the argmax, the entropy and the exploration in one program
+    def chosen(logits, legal):
+        log_probs = jax.nn.log_softmax(masked(logits, legal))
+        return (jax.random.categorical(jax.random.key(0), masked(logits, legal)), jnp.argmax(masked(logits, legal), axis=1),
+                -(jnp.exp(log_probs) * log_probs).sum(-1), pqn.epsilon_greedy(logits, jax.random.key(1), 1.0, legal))
+
+    logits = np.zeros((4000, ACTIONS), np.float32)
+    logits[:, 10] = 5.0  # an illegal favourite
+    sample, greedy, entropy, explored = chosen(logits, legal_actions(3))
     assert int(sample.max()) < 3 and set(np.unique(sample).tolist()) == {0, 1, 2}
-    assert int(jnp.argmax(masked(logits, legal), axis=1).max()) < 3
-    log_probs = jax.nn.log_softmax(masked(logits, legal))
-    entropy = -(jnp.exp(log_probs) * log_probs).sum(-1)
+    assert int(greedy.max()) < 3
     np.testing.assert_allclose(entropy, np.log(3), rtol=1e-6)
-    explored = pqn.epsilon_greedy(logits, jax.random.key(1), 1.0, legal)
     assert set(np.unique(explored).tolist()) == {0, 1, 2}
 
 
@@ -154,8 +157,11 @@ def _bits_of_agent(fn, params, obs, agent_map):
 def test_agent_map_one_by_one_is_bit_exact_where_vmap_is_not():
     network = QNetwork()
     obs = jnp.asarray(np.random.default_rng(0).random((4, 8, 4, 32, 64)) < 0.2, jnp.uint8)  # 4 agents x 8 frames
-    init = jax.jit(network.init)
-    params = jax.tree.map(lambda *x: np.stack(x), *[init(jax.random.key(k), obs[0, :1]) for k in range(4)])
+    # 4 agents' params drawn on the host at the scale of flax's init (its shapes only: no init program to compile)
+    shapes = jax.eval_shape(network.init, jax.random.key(0), obs[0, :1])
+    rng = np.random.default_rng(3)
+    scale = lambda s: 1 / np.sqrt(np.prod(s.shape[:-1])) if len(s.shape) > 1 else 0.1  # kernels: 1 / sqrt(fan in)  # noqa: E731
+    params = jax.tree.map(lambda s: (scale(s) * rng.normal(size=(4, *s.shape))).astype(np.float32), shapes)
 
     def grad(p, o):
         return jax.grad(lambda p: jax.nn.log_softmax(network.apply(p, o)).mean())(p)
