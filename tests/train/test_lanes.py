@@ -61,7 +61,7 @@ def _alone_rollout(env, params, key, actions):
 def test_a_lane_of_the_mix_plays_what_its_game_plays_alone(lanes):
     env, params = octax_core.make("Deep8", autoreset=True, max_episode_steps=CAP)
     key = jax.random.key(7)
-    actions = jax.random.randint(jax.random.key(8), (STEPS, ENVS), 0, env.num_actions)
+    actions = np.random.default_rng(8).integers(0, env.num_actions, (STEPS, ENVS)).astype(np.int32)  # drawn on the host
     mine, _ = _lane_rollout(lanes, 1, key, actions)
     theirs = _alone_rollout(env, params, key, actions)
     for name, a, b in zip(("obs", "reward", "terminated", "truncated"), mine, theirs):
@@ -71,7 +71,7 @@ def test_a_lane_of_the_mix_plays_what_its_game_plays_alone(lanes):
 
 def test_every_reset_keeps_the_lanes_game(lanes):
     """Airplane's lanes, the other game of the mix (the program of the test above, `game` its argument)."""
-    (_, _, terminated, truncated), state = _lane_rollout(lanes, 0, jax.random.key(0), jnp.zeros((STEPS, ENVS), jnp.int32))
+    (_, _, terminated, truncated), state = _lane_rollout(lanes, 0, jax.random.key(0), np.zeros((STEPS, ENVS), np.int32))
     assert (np.asarray(terminated) | np.asarray(truncated)).sum() >= ENVS * 3  # every lane restarted, again and again
     assert np.asarray(state.game).tolist() == [0] * ENVS and int(np.asarray(state.episode_step).max()) < CAP
 

@@ -72,24 +72,10 @@ def test_the_rate_and_the_entropy_weight_decay_linearly_over_the_run(run):
                                [0.01 + (0.002 - 0.01) * u / 6 for u in (0, 2, 4, 6)], rtol=1e-6)
 
 
-def test_the_loss_takes_the_updates_entropy_weight_from_the_batch(pooled):
+def test_the_loss_takes_the_updates_entropy_weight_from_the_batch(pooled, first_losses):
     """With ent_coef_final the batch ends with the update's weight, and the loss uses it, not ent_coef."""
-    from octax_gym.train.networks import masked
-    from octax_gym.train.ppo import ppo_loss
-
-    config, _, trainer, _, (after, batch, _) = pooled
-    flat = tuple(jax.tree.map(lambda x: x.reshape((-1,) + x.shape[2:]), batch))
-
-    def apply(params, obs, game, legal):
-        logits, value = trainer.network.apply(params, obs)
-        return masked(logits, legal), value
-
-    @jax.jit  # both losses in one program
-    def losses(minibatch):
-        return (ppo_loss(after.params, apply, config, minibatch),
-                ppo_loss(after.params, apply, config, minibatch + (jnp.full(minibatch[3].shape, 0.004, jnp.float32),)))
-
-    (plain, stats), (annealed, _) = losses(flat)
+    config = pooled[0]
+    (plain, stats), annealed = first_losses["plain"], first_losses["annealed"]
     np.testing.assert_allclose(annealed - plain, (config.ent_coef - 0.004) * stats["entropy"], rtol=1e-4)
 
 
@@ -146,72 +132,81 @@ def test_the_same_seed_gives_the_same_run(runs):
         np.testing.assert_array_equal(a, b)
 
 
-def _collect(config, game, rom):
-    """The lanes, the trainer, its first runner and its first rollout's (runner, batch, totals), in one program."""
-    lanes = SeatLanes((game,), dict(config.env_overrides), roms=[rom])
+@pytest.fixture(scope="module")
+def pooled(take_turns_rom):
+    """A pool trainer of TakeTurns (2 past selves, one on a seat of every env): its config, lanes,
+    trainer, first runner, first rollout's (runner, batch, totals), and, from the first runner,
+    the pool after each of 5 draws at updates 0..4 (params + update at update `update`) with the
+    pool's count after each; all in one program."""
+    config = dataclasses.replace(tiny(**POOLED), games=(TAKE_TURNS,))
+    lanes = SeatLanes((TAKE_TURNS,), dict(config.env_overrides), roms=[take_turns_rom])
     trainer = make_trainer(config, lanes)
 
     @jax.jit
     def first(key):
         runner = trainer.init(key, jnp.int32(0))
-        return runner, trainer.collect(runner)
+        drawn, counts = runner, []
+        for update in range(5):  # eval_interval = 2 updates: snapshots at updates 0, 2, 4 into a ring of 2
+            drawn = selfplay.draw_opponent(config, drawn._replace(
+                updates=jnp.int32(update), params=jax.tree.map(lambda x: x + update, drawn.params)))[0]
+            counts.append(drawn.pool.count)
+        return runner, trainer.collect(runner), (drawn.pool, jnp.stack(counts))
 
-    return (lanes, trainer, *first(jax.random.key(0)))
+    return (config, lanes, trainer, *first(jax.random.key(0)))
 
 
 @pytest.fixture(scope="module")
-def pooled(take_turns_rom):
-    """A pool trainer of TakeTurns (2 past selves, one on a seat of every env), its first runner and
-    its first rollout."""
-    config = dataclasses.replace(tiny(**POOLED), games=(TAKE_TURNS,))
-    return (config, *_collect(config, TAKE_TURNS, take_turns_rom))
-
-
-def test_a_past_self_plays_one_seat_of_an_env_and_its_samples_weigh_zero(pooled):
-    config, _, trainer, _, (after, batch, _) = pooled
-    weight = np.asarray(batch[-1]).reshape(config.num_steps, config.num_envs, 2)
-    # every env (pool_prob 1): one seat, the same for the whole rollout, played by the past self
-    assert (weight.sum(-1) == 1).all() and (weight == weight[:1]).all()
-    assert int(after.pool.count) == 1  # the first rollout's snapshot: the initial params
-
-    # A weight-0 sample trains nothing: whatever its action and advantage, the same gradient.
-    from octax_gym.train.ppo import ppo_loss
+def first_losses(pooled):
+    """ppo_loss on the pooled trainer's first batch (flattened), in one program: the loss and its
+    statistics; the loss with an entropy weight of 0.004 ending the batch (ent_coef_final's form);
+    its gradient, and its gradient on the batch with every weight-0 sample's action and advantage
+    changed."""
     from octax_gym.train.networks import masked
+    from octax_gym.train.ppo import ppo_loss
 
-    flat = jax.tree.map(lambda x: x.reshape((-1,) + x.shape[2:]), batch)
-    changed = list(flat)
-    zero = flat[-1] == 0
-    changed[3] = jnp.where(zero, 1 - flat[3], flat[3])  # actions (TakeTurns': no-op and its key)
-    changed[6] = jnp.where(zero, flat[6] + 100.0, flat[6])  # advantages
+    config, _, trainer, _, (after, batch, _), _ = pooled
 
     def apply(params, obs, game, legal):
         logits, value = trainer.network.apply(params, obs)
         return masked(logits, legal), value
 
-    grad = jax.jit(jax.grad(lambda p, minibatch: ppo_loss(p, apply, config, minibatch)[0]))
-    for a, b in zip(jax.tree.leaves(grad(after.params, tuple(flat))),
-                    jax.tree.leaves(grad(after.params, tuple(changed)))):
+    @jax.jit
+    def losses(params, flat):
+        zero = flat[-1] == 0
+        changed = list(flat)
+        changed[3] = jnp.where(zero, 1 - flat[3], flat[3])  # actions (TakeTurns': no-op and its key)
+        changed[6] = jnp.where(zero, flat[6] + 100.0, flat[6])  # advantages
+        grad = jax.grad(lambda p, minibatch: ppo_loss(p, apply, config, minibatch)[0])
+        return {"plain": ppo_loss(params, apply, config, flat),
+                "annealed": ppo_loss(params, apply, config, flat + (jnp.full(flat[3].shape, 0.004, jnp.float32),))[0],
+                "grad": grad(params, flat), "grad_changed": grad(params, tuple(changed))}
+
+    return losses(after.params, tuple(jax.tree.map(lambda x: x.reshape((-1,) + x.shape[2:]), batch)))
+
+
+def test_a_past_self_plays_one_seat_of_an_env_and_its_samples_weigh_zero(pooled, first_losses):
+    config, _, _, _, (after, batch, _), _ = pooled
+    weight = np.asarray(batch[-1]).reshape(config.num_steps, config.num_envs, 2)
+    # every env (pool_prob 1): one seat, the same for the whole rollout, played by the past self
+    assert (weight.sum(-1) == 1).all() and (weight == weight[:1]).all()
+    assert int(after.pool.count) == 1  # the first rollout's snapshot: the initial params
+    # A weight-0 sample trains nothing: whatever its action and advantage, the same gradient.
+    for a, b in zip(jax.tree.leaves(first_losses["grad"]), jax.tree.leaves(first_losses["grad_changed"])):
         np.testing.assert_allclose(a, b, rtol=1e-5, atol=1e-7)
 
 
 def test_the_pool_takes_a_snapshot_at_each_evaluations_update(pooled):
-    config, _, _, start, _ = pooled
-    draw = jax.jit(lambda r: selfplay.draw_opponent(config, r)[0])
-    runner, counts = start, []
-    for update in range(5):  # eval_interval = 2 updates: snapshots at updates 0, 2, 4 into a ring of 2
-        runner = draw(runner._replace(updates=jnp.int32(update),
-                                      params=jax.tree.map(lambda x: x + update, runner.params)))
-        counts.append(int(runner.pool.count))
-    assert counts == [1, 1, 2, 2, 2]
+    _, _, _, start, _, (pool, counts) = pooled
+    assert np.asarray(counts).tolist() == [1, 1, 2, 2, 2]
     leaf = lambda tree: np.asarray(jax.tree.leaves(tree)[0])  # noqa: E731
     base = leaf(start.params)
     # slot 0 holds update 4's params (base + 0+1+2+3+4), slot 1 update 2's (base + 0+1+2)
-    np.testing.assert_allclose(leaf(runner.pool.params)[0], base + 10, rtol=1e-6)
-    np.testing.assert_allclose(leaf(runner.pool.params)[1], base + 3, rtol=1e-6)
+    np.testing.assert_allclose(leaf(pool.params)[0], base + 10, rtol=1e-6)
+    np.testing.assert_allclose(leaf(pool.params)[1], base + 3, rtol=1e-6)
 
 
 def test_turn_based_legal_masks_come_from_the_state_and_are_honoured(pooled):
-    config, lanes, _, runner, (_, batch, _) = pooled
+    config, lanes, _, runner, (_, batch, _), _ = pooled
     legal, action = np.asarray(batch[2]), np.asarray(batch[3])  # (T, 2N, ACTIONS), (T, 2N)
     assert np.take_along_axis(legal, action[..., None], -1).all()  # never a closed action (the past self's neither)
     per_env = legal.reshape(config.num_steps, config.num_envs, 2, -1)
