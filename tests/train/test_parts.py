@@ -59,17 +59,27 @@ def test_same_padding_then_valid_is_flax_same_convolution():
     nn.Conv(padding="SAME") of every layer, on the shapes the layout meets."""
     import flax.linen as nn
 
+    convs = [nn.Conv(features, kernel, strides, padding="SAME") for features, kernel, strides in LAYERS]
     x = _normal((2, 4, 32, 64), 0)
-    for i, (features, kernel, strides) in enumerate(LAYERS):
-        conv = nn.Conv(features, kernel, strides, padding="SAME")
+    params, shape = [], x
+    for i, conv in enumerate(convs):
         # any params will do: drawn here at the scale of flax's init (its shapes only: no init program to compile)
-        shapes = jax.eval_shape(conv.init, jax.random.key(i), x)["params"]
-        params = {"kernel": _normal(shapes["kernel"].shape, 10 + i) / np.sqrt(np.prod(shapes["kernel"].shape[:-1])),
-                  "bias": 0.1 * _normal(shapes["bias"].shape, 20 + i)}
-        expected = conv.apply({"params": params}, x)
-        ours = conv_valid(same_padded(x, kernel, strides), params["kernel"], strides) + params["bias"]
+        shape, shapes = jax.eval_shape(conv.init_with_output, jax.random.key(i), shape)
+        shapes = shapes["params"]
+        params.append({"kernel": _normal(shapes["kernel"].shape, 10 + i) / np.sqrt(np.prod(shapes["kernel"].shape[:-1])),
+                       "bias": 0.1 * _normal(shapes["bias"].shape, 20 + i)})
+
+    @jax.jit  # every layer, ours and flax's, in one program
+    def both(x, params):
+        out = []
+        for (_, kernel, strides), conv, layer in zip(LAYERS, convs, params):
+            expected = conv.apply({"params": layer}, x)
+            out.append((conv_valid(same_padded(x, kernel, strides), layer["kernel"], strides) + layer["bias"], expected))
+            x = expected  # the next layer reads flax's output
+        return out
+
+    for ours, expected in both(x, params):
         np.testing.assert_allclose(ours, expected, rtol=1e-4, atol=1e-4)
-        x = expected
 
 
 def _normal(shape, seed):
@@ -108,8 +118,8 @@ def test_masked_actions_are_never_chosen_and_cost_no_entropy():
     logits = np.zeros((4000, ACTIONS), np.float32)
     logits[:, 10] = 5.0  # an illegal favourite
     sample, greedy, entropy, explored = chosen(logits, legal_actions(3))
-    assert int(sample.max()) < 3 and set(np.unique(sample).tolist()) == {0, 1, 2}
-    assert int(greedy.max()) < 3
+    assert int(np.max(sample)) < 3 and set(np.unique(sample).tolist()) == {0, 1, 2}
+    assert int(np.max(greedy)) < 3
     np.testing.assert_allclose(entropy, np.log(3), rtol=1e-6)
     assert set(np.unique(explored).tolist()) == {0, 1, 2}
 
