@@ -39,7 +39,8 @@ def _env(game_id: str):
 def _rollout(game_id: str, steps: int):
     """(seed, plan (steps, NUM_ENVS, 2)) -> per-step rewards (T, N, 2), done (T, N), V (T, N, 16),
     for NUM_ENVS envs; a plan entry is RANDOM, SCRIPTED or an action (NOOP = 0). Episodes are not
-    reset once done. The tests that drive seats by hand use it too.
+    reset once done. The tests that drive seats by hand use it too. RANDOM's actions are drawn on
+    the host (an argument), so the program holds no random-number generator for them.
 
     The reset is a small program of its own, and the rollout takes the start states, params and
     keys as arguments: it holds no level's data (the start states carry the level), so Cycles'
@@ -47,12 +48,10 @@ def _rollout(game_id: str, steps: int):
     env, params = _env(game_id)
     policy = env.seats.scripted_policy
 
-    def one(state, run_key, plan, params):
+    def one(state, run_key, plan, random_actions, params):
         def body(carry, inputs):
             state, done = carry
-            key, wanted = inputs
-            pick, step_key = jax.random.split(key)
-            random_actions = jax.random.randint(pick, (2,), 0, env.num_actions)
+            step_key, wanted, random_actions = inputs
             actions = jnp.stack([
                 jnp.select([wanted[seat] == SCRIPTED, wanted[seat] == RANDOM],
                            [policy(state.machine, seat), random_actions[seat]], wanted[seat])
@@ -63,19 +62,22 @@ def _rollout(game_id: str, steps: int):
             done = done | terminated | truncated
             return (new_state, done), (rewards, done, new_state.machine.V)
 
-        return jax.lax.scan(body, (state, jnp.bool_(False)), (jax.random.split(run_key, steps), plan))[1]
+        return jax.lax.scan(body, (state, jnp.bool_(False)), (jax.random.split(run_key, steps), plan, random_actions))[1]
 
     reset = jax.jit(jax.vmap(env.reset, in_axes=(0, None)))
-    run = jax.jit(jax.vmap(one, in_axes=(0, 0, 1, None)))
+    run = jax.jit(jax.vmap(one, in_axes=(0, 0, 1, 1, None)))
 
     def rollout(seed, plan):
-        """`seed`: an int (env i resets from its own key) or one key, which every env resets from."""
+        """`seed`: an int (env i resets from its own key; random play's actions are numpy's draws
+        from that seed) or one key, which every env resets from (random actions from seed 0)."""
         keys = jax.random.split(jax.random.key(seed), NUM_ENVS) if isinstance(seed, int) else \
             jnp.stack([seed] * NUM_ENVS)
+        random_actions = np.random.default_rng(seed if isinstance(seed, int) else 0).integers(
+            0, env.num_actions, (steps, NUM_ENVS, 2), np.int32)
         split = jax.vmap(jax.random.split)(keys)
         reset_keys, run_keys = split[:, 0], split[:, 1]
         _, state = reset(reset_keys, params)
-        return tuple(np.asarray(x).swapaxes(0, 1) for x in run(state, run_keys, jnp.asarray(plan, jnp.int32), params))
+        return tuple(np.asarray(x).swapaxes(0, 1) for x in run(state, run_keys, jnp.asarray(plan, jnp.int32), random_actions, params))
     return rollout
 
 
