@@ -29,17 +29,39 @@ def networks():
     return networks
 
 
+# Three screens of 4 random planes, drawn on the host: the tests' one batch of observations.
+OBS = np.random.default_rng(1).integers(0, 2, (3, 4, 32, 64), dtype=np.uint8)
+
+
+@pytest.fixture(scope="module")
+def initialized(networks):
+    """(network, params) of a trainer's network kind ("ppo" or "pqn") and width: the init's tree
+    (its shapes traced, not run), filled on the host with random weights of scale 1/sqrt(fan-in)
+    and small random biases. Which weights does not matter here (a file's params must play as the
+    network plays those params), and no init program is compiled."""
+    import jax
+
+    def get(kind: str, width: int):
+        network = networks.ActorCritic(width) if kind == "ppo" else networks.QNetwork(width)
+        rng = np.random.default_rng(width)
+        shapes = jax.eval_shape(network.init, jax.random.key(0), OBS)
+
+        def fill(leaf):
+            scale = 0.01 if len(leaf.shape) == 1 else 1 / np.sqrt(np.prod(leaf.shape[:-1]))
+            return (rng.standard_normal(leaf.shape) * scale).astype(leaf.dtype)
+        return network, jax.tree.map(fill, shapes)
+    return get
+
+
 @pytest.mark.parametrize("kind", ["ppo", "pqn"])
 @pytest.mark.parametrize("width", [3, 17], ids=["examples-file", "trainer-file"])
-def test_jax_params_play_as_the_trainers_network(networks, kind, width, tmp_path):
+def test_jax_params_play_as_the_trainers_network(initialized, kind, width, tmp_path):
     import flax.serialization
-    import jax
 
     from octax_gym.jax_policy import action_scores
 
-    network = networks.ActorCritic(width) if kind == "ppo" else networks.QNetwork(width)
-    obs = jax.random.randint(jax.random.key(1), (3, 4, 32, 64), 0, 2).astype(np.uint8)
-    params = network.init(jax.random.key(0), obs)
+    network, params = initialized(kind, width)
+    obs = OBS
     path = tmp_path / "params.msgpack"
     path.write_bytes(flax.serialization.to_bytes(params))
     ours = action_scores(flax.serialization.msgpack_restore(path.read_bytes()), obs)
@@ -53,18 +75,18 @@ def test_jax_params_play_as_the_trainers_network(networks, kind, width, tmp_path
         load_agent(path, 5 if width == 3 else 18)
 
 
-def test_float16_params_play_as_their_float32_originals(networks, tmp_path):
+def test_float16_params_play_as_their_float32_originals(initialized, tmp_path):
     import flax.serialization
     import jax
 
-    network = networks.ActorCritic()
-    obs = jax.random.randint(jax.random.key(1), (8, 4, 32, 64), 0, 2).astype(np.uint8)
-    params = network.init(jax.random.key(0), obs)
+    network, params = initialized("ppo", 17)  # a trainer's file, as the params test saves it
+    obs = OBS
     half = tmp_path / "half.msgpack"
     half.write_bytes(flax.serialization.to_bytes(jax.tree.map(lambda x: x.astype(np.float16), params)))
     agent = load_agent(half, 4)
     expected = np.asarray(network.apply(jax.tree.map(lambda x: x.astype(np.float16).astype(np.float32), params),
                                         obs)[0])[:, :4].argmax(-1)
+    assert len(set(expected)) > 1  # the rows' choices differ: a loader ignoring the screen would fail
     assert [agent(np.asarray(o)) for o in obs] == list(expected)
 
 
