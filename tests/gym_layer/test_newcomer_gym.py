@@ -139,7 +139,8 @@ def test_the_one_seat_views_masks_are_int8_and_sample_legal_actions(take_turns_r
     assert info["action_mask"].dtype == np.int8 and info["action_mask"].tolist() == [1, 0]  # seat 0 moves first
     assert env.action_space.sample(mask=info["action_mask"]) == 0
     assert env.action_masks().dtype == np.bool_  # what MaskablePPO reads
-    envs = OctaxVectorEnv(TAKE_TURNS, 3, rom=take_turns_rom, opponent="random")
+    # one env, autoreset disabled: test_opponent's turn-based single env's compiled step (random opponent)
+    envs = OctaxVectorEnv(TAKE_TURNS, 1, rom=take_turns_rom, opponent="random", autoreset_mode="disabled")
     _, info = envs.reset(seed=0)
     assert info["action_mask"].dtype == np.int8
     for _ in range(6):
