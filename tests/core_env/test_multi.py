@@ -133,46 +133,70 @@ def test_a_game_that_is_not_solo_is_refused_by_make_and_left_out_of_list_games()
         octax_core.list_games(players=3)
 
 
-def _random_rollout(env, params, keys, steps):
-    """One env per key under vmap, uniform random actions per seat drawn from its own key, autoreset."""
-    obs, state = jax.vmap(env.reset, in_axes=(0, None))(keys, params)
-
-    def one(carry, t):
-        state, keys = carry
-        split = jax.vmap(lambda k: jax.random.split(k, 3))(keys)
-        actions = jax.vmap(lambda k: jax.random.randint(k, (2,), 0, env.num_actions))(split[:, 1])
-        obs, state, reward, terminated, truncated, info = jax.vmap(env.step, in_axes=(0, 0, 0, None))(
-            split[:, 2], state, actions, params)
-        return (state, split[:, 0]), (obs, reward, terminated, truncated, info["score"])
-
-    return jax.lax.scan(one, (state, keys), jnp.arange(steps))[1]
+STEPS, ENVS = 40, 4  # the rollout's length, and the batch whose envs are also run alone
 
 
-def test_same_seed_same_trajectory_whatever_the_batch(counters):
-    _, _, _, path = counters
-    env, params = octax_core.make_multi(TWO_COUNTERS, rom=path, autoreset=True, repeat_action_probability=0.25)
-    rollout = jax.jit(_random_rollout, static_argnums=(0, 3))
-    keys = jax.random.split(jax.random.key(7), 4)
-    batch = rollout(env, params, keys, 40)
+@pytest.fixture(scope="module")
+def autoresetting(counters):
+    """The autoresetting TwoCounters env and one jitted rollout of it, whose params are an argument:
+    (env, params with the given sticky probability, rollout). `rollout(keys, actions, params)`
+    resets one env per key of keys[0], then steps each with its own keys[t + 1] and actions[t];
+    per step it returns (obs, state, reward, terminated, truncated, info), batched. Its actions
+    come from the host, so the tests below run the one program per batch size."""
+    env, _ = octax_core.make_multi(TWO_COUNTERS, rom=counters[3], autoreset=True)
+
+    def rollout(keys, actions, params):
+        _, state = jax.vmap(env.reset, in_axes=(0, None))(keys[0], params)
+
+        def one(state, xs):
+            step_keys, actions = xs
+            obs, state, reward, terminated, truncated, info = jax.vmap(env.step, in_axes=(0, 0, 0, None))(
+                step_keys, state, actions, params)
+            return state, (obs, state, reward, terminated, truncated, info)
+
+        return jax.lax.scan(one, state, (keys[1:], actions))[1]
+
+    def params(repeat_action_probability):
+        made, params = octax_core.make_multi(TWO_COUNTERS, rom=counters[3], autoreset=True,
+                                             repeat_action_probability=repeat_action_probability)
+        assert made.config == env.config  # the sticky probability is a param: the same program
+        return params
+
+    return env, params, jax.jit(rollout)
+
+
+def test_same_seed_same_trajectory_whatever_the_batch(autoresetting):
+    """Env i of a batch of 4 plays what env i alone plays, bit for bit: random actions per seat,
+    sticky actions drawn from the step keys, episodes ended and autoreset within the rollout."""
+    env, params, rollout = autoresetting
+    params = params(0.25)
+    keys = jax.random.split(jax.random.key(7), (STEPS + 1, ENVS))
+    actions = np.random.default_rng(7).integers(0, env.num_actions, (STEPS, ENVS, 2)).astype(np.int32)
+    batch = rollout(keys, actions, params)
     for i in (0, 2):
-        alone = rollout(env, params, keys[i:i + 1], 40)
-        for together, by_itself in zip(batch, alone):
-            np.testing.assert_array_equal(together[:, i], by_itself[:, 0])
-    assert np.asarray(batch[2]).any()  # episodes ended and were reset within the rollout
-    assert not np.array_equal(batch[1][:, 0], batch[1][:, 1])  # the envs play differently
+        alone = rollout(keys[:, i:i + 1], actions[:, i:i + 1], params)
+        for together, by_itself in zip(jax.tree.leaves(batch), jax.tree.leaves(alone)):
+            if jnp.issubdtype(together.dtype, jax.dtypes.prng_key):
+                together, by_itself = jax.random.key_data(together), jax.random.key_data(by_itself)
+            np.testing.assert_array_equal(np.asarray(together)[:, i], np.asarray(by_itself)[:, 0])
+    assert np.asarray(batch[3]).any()  # episodes ended and were reset within the rollout
+    assert not np.array_equal(batch[2][:, 0], batch[2][:, 1])  # the envs play differently
 
 
-def test_autoreset_starts_a_new_episode_for_both_seats(counters):
-    _, _, _, path = counters
-    env, params = octax_core.make_multi(TWO_COUNTERS, rom=path, autoreset=True)
-    step = jax.jit(env.step)
-    obs, state = env.reset(jax.random.key(0), params)
-    for t in range(3):
-        obs, state, reward, terminated, truncated, info = step(jax.random.key(t), state, jnp.array([2, 0]), params)
-    assert bool(terminated) and bool(info["_final"])
-    assert info["final_observation"].shape == (2, 5, 32, 64)
-    assert int(state.machine.V[0]) == 0 and int(state.episode_step) == 0
-    np.testing.assert_array_equal(info["score"], [24.0, 0.0])
+def test_autoreset_starts_a_new_episode_for_both_seats(autoresetting):
+    """Seat 0 holds its second key (8 a step): the third step ends the episode at 24, and that
+    step returns the new episode's state with the ended one's score and observation in info.
+    One env of the rollout above (the same program: its batch of one)."""
+    env, params, rollout = autoresetting
+    keys = jax.random.split(jax.random.key(0), (STEPS + 1, 1))
+    actions = np.broadcast_to(np.array([2, 0], np.int32), (STEPS, 1, 2))
+    obs, state, reward, terminated, truncated, info = jax.tree.map(lambda x: x[:, 0], rollout(keys, actions, params(0.0)))
+    assert np.asarray(terminated)[:3].tolist() == [False, False, True]
+    assert bool(info["_final"][2]) and not np.asarray(info["_final"])[:2].any()
+    assert info["final_observation"][2].shape == (2, 5, 32, 64)
+    assert int(state.machine.V[2, 0]) == 0 and int(state.episode_step[2]) == 0
+    np.testing.assert_array_equal(info["score"][2], [24.0, 0.0])
+    np.testing.assert_array_equal(info["score"][3], [8.0, 0.0])  # the new episode plays on
 
 
 def test_sticky_actions_are_per_seat(counters):
