@@ -1,13 +1,13 @@
 """skip_idle is exact: generated programs full of wait loops run bit-identically with and without it.
 
-Each example is a batch of three different programs (their states stacked, so every machine of the
+Each example is a batch of six different programs (their states stacked, so every machine of the
 batch runs its own code, as envs of different episodes do), built from blocks that spin in the
 ways real games wait: on the delay timer, on a key held or not held, in FX0A, on a jump to itself,
 and a counter loop that ends. Between the waits come register work, draws, stores, random numbers
 and (on XO-CHIP, SUPER-CHIP's opcodes included) mode switches, scrolls, planes and long I loads,
 so a spin may start anywhere in a frame and the detector must restart after every write. Both
-machines run the same calls with the same keys; every field of every state and every recorded
-screen must match.
+machines run the same one-frame calls with the same keys; every field of every state (the
+screens included) must match after every frame.
 """
 
 import functools
@@ -26,28 +26,27 @@ from octax_core.emulator.opcodes import Kind
 from octax_core.emulator.state import shown
 
 PROGRAM_START = 0x200
-BATCH = 3
-CALLS = 5  # run_frames calls per example, each with its own keys
-FRAMES_PER_CALL = 2
+BATCH = 6
+CALLS = 10  # one-frame run_frames calls per example, each with its own keys
 SETTINGS = settings(max_examples=25, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 
 # Each machine is two compiled programs (skipping and plain), so the property runs on the two
 # most distinct: the VIP's CHIP-8, where a draw ends the frame (display wait) 40 instructions in,
-# and XO-CHIP at 300 instructions a frame without display wait, whose programs also take every
-# SUPER-CHIP block (mode switches, scrolls, 16x16 sprites, flags) and its own (planes, long I, 64
-# KiB). A SUPER-CHIP machine and a fast CHIP-8 one sit between the two; the archive programs
-# (test_archive_platforms.py) run idle skipping on SUPER-CHIP against the reference.
+# and XO-CHIP at 30 instructions a frame (two chunks of 15) without display wait, whose programs
+# also take every SUPER-CHIP block (mode switches, scrolls, 16x16 sprites, flags) and its own
+# (planes, long I, 64 KiB). A SUPER-CHIP machine and a fast CHIP-8 one sit between the two; the
+# archive programs (test_archive_platforms.py) run idle skipping on SUPER-CHIP against the
+# reference. Both run the folder's batched one-frame program (conftest.py), six machines a batch:
+# XO-CHIP's skipping one is test_one_machine.py's plane-2 and GPU-form tests' and
+# test_platforms.py's batch test's (one compile for all).
 MACHINES = {
     "chip8-vip": dict(platform="chip8", quirks="chip8", instructions_per_frame=40),
-    "xochip": dict(platform="xochip", instructions_per_frame=300),
+    "xochip": dict(platform="xochip", instructions_per_frame=30),
 }
 
 
-@functools.lru_cache(maxsize=None)
-def runner(name: str, skip_idle: bool):
-    machine = octax_core.Machine(**MACHINES[name], skip_idle=skip_idle)
-    run = jax.vmap(lambda state, keys: machine.run_frames(state, keys, FRAMES_PER_CALL, record_screens=True))
-    return machine, jax.jit(run)
+def machine_of(name: str, skip_idle: bool) -> octax_core.Machine:
+    return octax_core.Machine(**MACHINES[name], skip_idle=skip_idle)
 
 
 # ---- programs: blocks that are assembled at a known address (jumps point back into them) ----------
@@ -168,23 +167,24 @@ def first_mismatch(a, b):
 
 
 @pytest.mark.parametrize("name", list(MACHINES))
-def test_wait_loops_run_bit_identically_with_skip_idle(name):
+def test_wait_loops_run_bit_identically_with_skip_idle(name, jit_batch_run_frames):
     key_masks = st.lists(st.one_of(st.just(0), st.integers(0, 15).map(lambda k: 1 << k), st.integers(0, 0xFFFF)),
                          min_size=CALLS * BATCH, max_size=CALLS * BATCH)
+    machine = machine_of(name, True)
+    assert machine.skipping
+    skipping = jit_batch_run_frames(machine, 1)
+    plain = jit_batch_run_frames(machine_of(name, False), 1)
 
     @SETTINGS
     @given(roms=st.lists(program(name), min_size=BATCH, max_size=BATCH), keys=key_masks, seed=st.integers(0, 2**16))
     def check(roms, keys, seed):
-        machine, skipping = runner(name, True)
-        _, plain = runner(name, False)
         fast = slow = stacked_boot(machine, roms, seed)
         keys = np.asarray(keys, np.uint32).reshape(CALLS, BATCH)
-        for call in range(CALLS):
-            fast, fast_screens = skipping(fast, keys[call])
-            slow, slow_screens = plain(slow, keys[call])
-            assert np.array_equal(fast_screens, slow_screens), f"call {call}: screens differ"
+        for call in range(CALLS):  # a frame a call: the state, screens included, after every frame
+            fast = skipping(fast, keys[call])
+            slow = plain(slow, keys[call])
             where = first_mismatch(slow, fast)
-            assert where is None, f"call {call}: {where} differs ({[r.hex() for r in roms]})"
+            assert where is None, f"frame {call}: {where} differs ({[r.hex() for r in roms]})"
 
     check()
 
