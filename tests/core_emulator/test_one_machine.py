@@ -297,54 +297,90 @@ def test_on_a_host_with_one_kind_of_backend_only_its_branch_is_traced(monkeypatc
     assert traced == ["always"]
 
 
-# SUPER-CHIP and XO-CHIP archive programs that draw in hires, scroll and switch modes
-GATED_PROGRAMS = ("sens8tion", "superOctoTrackXO",  # SUPER-CHIP, XO-CHIP; two more in make test-slow
-                  pytest.param("sweetcopter", marks=pytest.mark.slow), pytest.param("OctoPartyMix", marks=pytest.mark.slow))
-
-
-@pytest.mark.parametrize("name", GATED_PROGRAMS)
-def test_the_gpu_form_of_the_gates_plays_the_same_batch(name, monkeypatch):
-    """The batched machine with every gate always running (the form GPUs get) equals the looped
-    form bit for bit: 4 machines, each with its own key schedule, 96 frames, every state field and
-    recorded picture."""
+def _archive(name: str) -> tuple[dict, bytes]:
+    """An archive program's programs.json entry and ROM."""
     import json
 
-    from octax_core.emulator import gate
-    from octax_core.emulator.quirks import quirks_from_octo
     from octax_core.env.romstore import ARCHIVE_ROM_DIR
 
-    entry = json.loads((ARCHIVE_ROM_DIR / "programs.json").read_text())[name]
-    rom = (ARCHIVE_ROM_DIR / f"{name}.ch8").read_bytes()
-    options = entry["options"]
-    holds = np.array([[(1 << ((h + m * 3) % 16)) if (h + m) % 2 else 0 for h in range(12)] for m in range(4)],
-                     np.uint32)  # machine m holds key ... for 8 frames, then nothing, each its own schedule
+    return (json.loads((ARCHIVE_ROM_DIR / "programs.json").read_text())[name],
+            (ARCHIVE_ROM_DIR / f"{name}.ch8").read_bytes())
 
-    def play():
-        frame.frame_runner.cache_clear()  # a new trace, which reads LOOPED_PLATFORMS
-        machine = octax_core.Machine(entry["platform"], quirks=quirks_from_octo(options),
-                                     instructions_per_frame=int(options.get("tickrate", 20)))
-        state = jax.vmap(lambda k: machine.boot(rom, k))(jax.random.split(jax.random.key(3), 4))
-        step = jax.jit(jax.vmap(lambda s, k: machine.run_frames(s, k, 8, record_screens=True)))
+
+def _holds(machines: int) -> np.ndarray:
+    """(machines, 12) key masks: machine m holds a key for 8 frames, then nothing, each its own schedule."""
+    return np.array([[(1 << ((h + m * 3) % 16)) if (h + m) % 2 else 0 for h in range(12)] for m in range(machines)],
+                    np.uint32)
+
+
+def _assert_the_gpu_form_plays_alike(monkeypatch, machine, state, looped):
+    """Plays `state` (a batch) 96 one-frame calls with `_holds`' schedules on the `looped` program,
+    then on the same machine's program with every gate always running (the form GPUs get): the
+    two are equal bit for bit, every picture and every field of the final state."""
+    from octax_core.emulator import gate
+
+    holds = _holds(len(state.pc))
+
+    def play(step):
         loops = step.lower(state, jnp.asarray(holds[:, 0])).as_text().count("stablehlo.while")
-        pictures = []
+        now, pictures = state, []
         for h in range(holds.shape[1]):
-            state, screens = step(state, jnp.asarray(holds[:, h]))
-            pictures.append(np.asarray(screens))
-        return state, np.concatenate(pictures, axis=1), loops
+            for _ in range(8):
+                now = step(now, jnp.asarray(holds[:, h]))
+                pictures.append((np.asarray(now.screen), np.asarray(now.extension.grid)))
+        return now, pictures, loops
 
-    looped_state, looped_pictures, looped_loops = play()
+    frame.frame_runner.cache_clear()  # a new trace reads LOOPED_PLATFORMS
+    looped_state, looped_pictures, looped_loops = play(looped)
     monkeypatch.setattr(gate, "LOOPED_PLATFORMS", ())
-    always_state, always_pictures, always_loops = play()
+    frame.frame_runner.cache_clear()
+    always = jax.jit(jax.vmap(lambda s, k: machine.run_frames(s, k, 1)), compiler_options=machine.compiler_options)
+    always_state, always_pictures, always_loops = play(always)
     frame.frame_runner.cache_clear()
     if jax.default_backend() in gate.LOOPED_PLATFORMS:  # (elsewhere both runs are the always form)
         assert always_loops < looped_loops  # the gates' loops are gone from the program
-    assert looped_pictures.any()
-    np.testing.assert_array_equal(always_pictures, looped_pictures)
+    assert any(screen.any() or grid.any() for screen, grid in looped_pictures)
+    for t, ((a, b), (c, d)) in enumerate(zip(always_pictures, looped_pictures)):
+        np.testing.assert_array_equal(a, c, err_msg=f"frame {t}: screen")
+        np.testing.assert_array_equal(b, d, err_msg=f"frame {t}: grid")
     for path, a, b in zip(jax.tree_util.tree_flatten_with_path(looped_state)[0],
                           jax.tree.leaves(always_state), jax.tree.leaves(looped_state)):
         if jnp.issubdtype(a.dtype, jax.dtypes.prng_key):
             a, b = jax.random.key_data(a), jax.random.key_data(b)
         np.testing.assert_array_equal(np.asarray(a), np.asarray(b), err_msg=str(path[0]))
+    return looped_pictures
+
+
+def test_the_gpu_form_of_the_gates_plays_the_same_batch(monkeypatch, jit_batch_run_frames):
+    """The batched machine with every gate always running (the form GPUs get) equals the looped
+    form bit for bit: 6 machines, each with its own key schedule, 96 frames. Three archive programs
+    share the batch, two machines each: sens8tion (SUPER-CHIP: switches between hires and lores),
+    OctoPartyMix (XO-CHIP, both planes in lores) and jub8-1 (XO-CHIP, both planes in hires), on the
+    XO-CHIP machine (it runs every SUPER-CHIP opcode and has every gate) of the plane-2 test, whose
+    batched one-frame program is the looped form here (one compile for both)."""
+    machine = octax_core.Machine("xochip", instructions_per_frame=30)
+    roms = [_archive(name)[1] for name in ("sens8tion", "OctoPartyMix", "jub8-1") for _ in range(2)]
+    states = [machine.boot(rom, key) for rom, key in zip(roms, jax.random.split(jax.random.key(3), 6))]
+    state = jax.tree.map(lambda *leaves: jnp.stack(leaves), *states)
+    pictures = _assert_the_gpu_form_plays_alike(monkeypatch, machine, state, jit_batch_run_frames(machine, 1))
+    drew = lambda surface, plane: [any(p[surface][m, plane].any() for p in pictures) for m in range(6)]
+    assert drew(0, 0) == [True] * 4 + [False] * 2 and drew(1, 0) == [True, True, False, False, True, True]
+    assert drew(0, 1) == [False, False, True, True, False, False] and drew(1, 1)[4:] == [True, True]  # plane 2
+
+
+@pytest.mark.slow  # the fast test above plays a SUPER-CHIP and an XO-CHIP program in one batch
+@pytest.mark.parametrize("name", ["sweetcopter", "superOctoTrackXO"])
+def test_the_gpu_form_of_the_gates_plays_each_program_on_its_own_machine(name, monkeypatch):
+    """The same, 4 machines of one archive program on its own machine (platform, quirks, tick rate)."""
+    from octax_core.emulator.quirks import quirks_from_octo
+
+    entry, rom = _archive(name)
+    options = entry["options"]
+    machine = octax_core.Machine(entry["platform"], quirks=quirks_from_octo(options),
+                                 instructions_per_frame=int(options.get("tickrate", 20)))
+    state = jax.vmap(lambda k: machine.boot(rom, k))(jax.random.split(jax.random.key(3), 4))
+    looped = jax.jit(jax.vmap(lambda s, k: machine.run_frames(s, k, 1)), compiler_options=machine.compiler_options)
+    _assert_the_gpu_form_plays_alike(monkeypatch, machine, state, looped)
 
 
 def test_the_rare_work_crosses_into_its_gate_as_one_word():
