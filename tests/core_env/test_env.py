@@ -145,17 +145,18 @@ def test_batched_autoreset_is_the_select_it_gates(counter):
     # the same compiled reset); restarted with other keys they draw other starts.
     env, params, _, _ = counter(noop_max=30)
     obs, state = batched_reset(env)(noop_keys(), params)
-    gated = jax.jit(jax.vmap(env.autoreset, in_axes=(0, 0, 0, 0, None)))
-
     def plain(key, mask, obs, state):
         fresh = env.reset_env(key, params)
         return jax.tree.map(lambda new, old: jax.numpy.where(mask, new, old), fresh, (obs, state))
 
-    plain = jax.jit(jax.vmap(plain))
+    @jax.jit  # both in one program
+    def gated_and_plain(keys, mask, obs, state):
+        return (jax.vmap(env.autoreset, in_axes=(0, 0, 0, 0, None))(keys, mask, obs, state, params),
+                jax.vmap(plain)(keys, mask, obs, state))
+
     new_keys = jax.random.split(jax.random.key(9), 16)
     for mask in (np.zeros(16, bool), np.arange(16) % 3 == 1, np.ones(16, bool)):
-        got = gated(new_keys, mask, obs, state, params)
-        want = plain(new_keys, mask, obs, state)
+        got, want = gated_and_plain(new_keys, mask, obs, state)
         for a, b in zip(jax.tree.leaves(got), jax.tree.leaves(want)):
             if jax.numpy.issubdtype(a.dtype, jax.dtypes.prng_key):
                 a, b = jax.random.key_data(a), jax.random.key_data(b)

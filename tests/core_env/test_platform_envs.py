@@ -162,5 +162,10 @@ def test_unknown_platform_in_a_spec(tmp_path):
 
 
 def test_the_env_contract_suite_passes_on_xochip(games):
+    """Shapes, dtypes, the four plane codes, determinism, one trace, refused actions, on XO-CHIP.
+    One env, so the suite's batch and its env run alone are one compiled step: that env i of a
+    batch is the env alone is the env layer's promise, whatever the platform (test_env.py's
+    contract suite, three envs), and XO-CHIP's machine keeps it (tests/core_emulator/
+    test_platforms.py::test_batches_run_each_machine_as_alone)."""
     spec, path = games["xochip"]
-    octax_core.check_env(spec, rom=path)  # shapes, dtypes, determinism whatever the batch, ...
+    octax_core.check_env(spec, rom=path, num_envs=1)
