@@ -313,36 +313,32 @@ def _holds(machines: int) -> np.ndarray:
                     np.uint32)
 
 
-def _assert_the_gpu_form_plays_alike(monkeypatch, machine, state, looped):
-    """Plays `state` (a batch) 96 one-frame calls with `_holds`' schedules on the `looped` program,
-    then on the same machine's program with every gate always running (the form GPUs get): the
-    two are equal bit for bit, every picture and every field of the final state."""
+def _assert_the_gpu_form_plays_alike(monkeypatch, machine, state):
+    """Plays `state` (a batch) 96 frames, 8 recorded frames a call with `_holds`' schedules, on the
+    looped machine, then with every gate always running (the form GPUs get): the two are equal bit
+    for bit, every recorded picture and every field of the final state. Returns the pictures."""
     from octax_core.emulator import gate
 
     holds = _holds(len(state.pc))
 
-    def play(step):
+    def play():
+        frame.frame_runner.cache_clear()  # a new trace, which reads LOOPED_PLATFORMS
+        step = jax.jit(jax.vmap(lambda s, k: machine.run_frames(s, k, 8, record_screens=True)))
         loops = step.lower(state, jnp.asarray(holds[:, 0])).as_text().count("stablehlo.while")
         now, pictures = state, []
         for h in range(holds.shape[1]):
-            for _ in range(8):
-                now = step(now, jnp.asarray(holds[:, h]))
-                pictures.append((np.asarray(now.screen), np.asarray(now.extension.grid)))
-        return now, pictures, loops
+            now, screens = step(now, jnp.asarray(holds[:, h]))
+            pictures.append(np.asarray(screens))
+        return now, np.concatenate(pictures, axis=1), loops
 
-    frame.frame_runner.cache_clear()  # a new trace reads LOOPED_PLATFORMS
-    looped_state, looped_pictures, looped_loops = play(looped)
+    looped_state, looped_pictures, looped_loops = play()
     monkeypatch.setattr(gate, "LOOPED_PLATFORMS", ())
-    frame.frame_runner.cache_clear()
-    always = jax.jit(jax.vmap(lambda s, k: machine.run_frames(s, k, 1)), compiler_options=machine.compiler_options)
-    always_state, always_pictures, always_loops = play(always)
+    always_state, always_pictures, always_loops = play()
     frame.frame_runner.cache_clear()
     if jax.default_backend() in gate.LOOPED_PLATFORMS:  # (elsewhere both runs are the always form)
         assert always_loops < looped_loops  # the gates' loops are gone from the program
-    assert any(screen.any() or grid.any() for screen, grid in looped_pictures)
-    for t, ((a, b), (c, d)) in enumerate(zip(always_pictures, looped_pictures)):
-        np.testing.assert_array_equal(a, c, err_msg=f"frame {t}: screen")
-        np.testing.assert_array_equal(b, d, err_msg=f"frame {t}: grid")
+    assert looped_pictures.any()
+    np.testing.assert_array_equal(always_pictures, looped_pictures)
     for path, a, b in zip(jax.tree_util.tree_flatten_with_path(looped_state)[0],
                           jax.tree.leaves(always_state), jax.tree.leaves(looped_state)):
         if jnp.issubdtype(a.dtype, jax.dtypes.prng_key):
@@ -351,21 +347,19 @@ def _assert_the_gpu_form_plays_alike(monkeypatch, machine, state, looped):
     return looped_pictures
 
 
-def test_the_gpu_form_of_the_gates_plays_the_same_batch(monkeypatch, jit_batch_run_frames):
+def test_the_gpu_form_of_the_gates_plays_the_same_batch(monkeypatch):
     """The batched machine with every gate always running (the form GPUs get) equals the looped
     form bit for bit: 6 machines, each with its own key schedule, 96 frames. Three archive programs
     share the batch, two machines each: sens8tion (SUPER-CHIP: switches between hires and lores),
-    OctoPartyMix (XO-CHIP, both planes in lores) and jub8-1 (XO-CHIP, both planes in hires), on the
-    XO-CHIP machine (it runs every SUPER-CHIP opcode and has every gate) of the plane-2 test, whose
-    batched one-frame program is the looped form here (one compile for both)."""
+    OctoPartyMix (XO-CHIP, both planes in lores) and jub8-1 (XO-CHIP, both planes in hires), on one
+    XO-CHIP machine (it runs every SUPER-CHIP opcode and has every gate): one program per form."""
     machine = octax_core.Machine("xochip", instructions_per_frame=30)
     roms = [_archive(name)[1] for name in ("sens8tion", "OctoPartyMix", "jub8-1") for _ in range(2)]
     states = [machine.boot(rom, key) for rom, key in zip(roms, jax.random.split(jax.random.key(3), 6))]
     state = jax.tree.map(lambda *leaves: jnp.stack(leaves), *states)
-    pictures = _assert_the_gpu_form_plays_alike(monkeypatch, machine, state, jit_batch_run_frames(machine, 1))
-    drew = lambda surface, plane: [any(p[surface][m, plane].any() for p in pictures) for m in range(6)]
-    assert drew(0, 0) == [True] * 4 + [False] * 2 and drew(1, 0) == [True, True, False, False, True, True]
-    assert drew(0, 1) == [False, False, True, True, False, False] and drew(1, 1)[4:] == [True, True]  # plane 2
+    pictures = _assert_the_gpu_form_plays_alike(monkeypatch, machine, state)  # (6, 96, planes, 64, 4)
+    drew = pictures.reshape(6, 96, 2, -1).any(axis=(1, 3))  # (machine, plane)
+    assert drew[:, 0].all() and list(drew[:, 1]) == [False, False, True, True, True, True]  # plane 2: XO-CHIP's
 
 
 @pytest.mark.slow  # the fast test above plays a SUPER-CHIP and an XO-CHIP program in one batch
@@ -379,8 +373,7 @@ def test_the_gpu_form_of_the_gates_plays_each_program_on_its_own_machine(name, m
     machine = octax_core.Machine(entry["platform"], quirks=quirks_from_octo(options),
                                  instructions_per_frame=int(options.get("tickrate", 20)))
     state = jax.vmap(lambda k: machine.boot(rom, k))(jax.random.split(jax.random.key(3), 4))
-    looped = jax.jit(jax.vmap(lambda s, k: machine.run_frames(s, k, 1)), compiler_options=machine.compiler_options)
-    _assert_the_gpu_form_plays_alike(monkeypatch, machine, state, looped)
+    _assert_the_gpu_form_plays_alike(monkeypatch, machine, state)
 
 
 def test_the_rare_work_crosses_into_its_gate_as_one_word():
