@@ -5,7 +5,6 @@ change every few calls. The batch takes its keys as bool[8, 16], the single runs
 masks, so both key forms are covered too.
 """
 
-import functools
 import random
 import zlib
 from pathlib import Path
@@ -30,11 +29,6 @@ FRAMES_PER_CALL = 10
 CALLS = 20
 
 
-@functools.lru_cache(maxsize=None)
-def jitted_batched_run(machine, frames):
-    return jax.jit(jax.vmap(lambda state, keys: machine.run_frames(state, keys, frames)))
-
-
 def unbatch(snap, index):
     return {name: value[index] for name, value in snap.items()}
 
@@ -57,7 +51,7 @@ def as_bools(masks):
 
 
 @pytest.mark.parametrize("rom_path, profile", CASES)
-def test_batched_equals_single(rom_path, profile, jit_run_frames):
+def test_batched_equals_single(rom_path, profile, jit_run_frames, jit_batch_run_frames):
     rom = rom_path.read_bytes()
     machine = octax_core.Machine(quirks=profile, instructions_per_frame=11)
     boot_keys = jax.random.split(jax.random.key(7), BATCH)
@@ -67,7 +61,7 @@ def test_batched_equals_single(rom_path, profile, jit_run_frames):
     assert len(set(rngs.tolist())) == BATCH, "boot keys should give different rng states"
 
     run_single = jit_run_frames(machine)  # one frame a call: test_differential.py's program, one compile for both
-    run_batch = jitted_batched_run(machine, FRAMES_PER_CALL)
+    run_batch = jit_batch_run_frames(machine, FRAMES_PER_CALL)  # the folder's batched runner (conftest.py)
     for call, masks in enumerate(key_masks(zlib.crc32(rom_path.name.encode()))):
         batch = run_batch(batch, as_bools(masks))
         for _ in range(FRAMES_PER_CALL):
