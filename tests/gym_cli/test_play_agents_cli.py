@@ -18,6 +18,8 @@ import pytest
 from octax_gym.play.agents import load_agent
 from octax_gym.play.session import Session
 
+from host_params import fill_like
+
 REPO = Path(__file__).resolve().parents[2]
 GAME = "Dodge"
 
@@ -35,21 +37,14 @@ OBS = np.random.default_rng(1).integers(0, 2, (3, 4, 32, 64), dtype=np.uint8)
 
 @pytest.fixture(scope="module")
 def initialized(networks):
-    """(network, params) of a trainer's network kind ("ppo" or "pqn") and width: the init's tree
-    (its shapes traced, not run), filled on the host with random weights of scale 1/sqrt(fan-in)
-    and small random biases. Which weights does not matter here (a file's params must play as the
-    network plays those params), and no init program is compiled."""
+    """(network, params) of a trainer's network kind ("ppo" or "pqn") and width, the params drawn
+    on the host in its init's shapes (tests/host_params.py). Which weights does not matter here (a
+    file's params must play as the network plays those params), and no init program is compiled."""
     import jax
 
     def get(kind: str, width: int):
         network = networks.ActorCritic(width) if kind == "ppo" else networks.QNetwork(width)
-        rng = np.random.default_rng(width)
-        shapes = jax.eval_shape(network.init, jax.random.key(0), OBS)
-
-        def fill(leaf):
-            scale = 0.01 if len(leaf.shape) == 1 else 1 / np.sqrt(np.prod(leaf.shape[:-1]))
-            return (rng.standard_normal(leaf.shape) * scale).astype(leaf.dtype)
-        return network, jax.tree.map(fill, shapes)
+        return network, fill_like(jax.eval_shape(network.init, jax.random.key(0), OBS), seed=width)
     return get
 
 

@@ -17,6 +17,7 @@ import flax.serialization  # noqa: E402
 from octax_gym.train import many, ppo, pqn  # noqa: E402
 from octax_gym.train.networks import (ACTIONS, LAYERS, ActorCritic, ConvTorso, QNetwork, _sliced_patches,  # noqa: E402
                                       conv_valid, legal_actions, masked, network_for, patches, same_padded)
+from host_params import fill_like  # noqa: E402
 
 
 def test_network_shapes_and_a_fixed_width():
@@ -63,11 +64,9 @@ def test_same_padding_then_valid_is_flax_same_convolution():
     x = _normal((2, 4, 32, 64), 0)
     params, shape = [], x
     for i, conv in enumerate(convs):
-        # any params will do: drawn here at the scale of flax's init (its shapes only: no init program to compile)
+        # any params will do: drawn on the host (tests/host_params.py: no init program to compile)
         shape, shapes = jax.eval_shape(conv.init_with_output, jax.random.key(i), shape)
-        shapes = shapes["params"]
-        params.append({"kernel": _normal(shapes["kernel"].shape, 10 + i) / np.sqrt(np.prod(shapes["kernel"].shape[:-1])),
-                       "bias": 0.1 * _normal(shapes["bias"].shape, 20 + i)})
+        params.append(fill_like(shapes["params"], seed=10 + i))
 
     @jax.jit  # every layer, ours and flax's, in one program
     def both(x, params):
@@ -167,11 +166,8 @@ def _bits_of_agent(fn, params, obs, agent_map):
 def test_agent_map_one_by_one_is_bit_exact_where_vmap_is_not():
     network = QNetwork()
     obs = jnp.asarray(np.random.default_rng(0).random((4, 8, 4, 32, 64)) < 0.2, jnp.uint8)  # 4 agents x 8 frames
-    # 4 agents' params drawn on the host at the scale of flax's init (its shapes only: no init program to compile)
-    shapes = jax.eval_shape(network.init, jax.random.key(0), obs[0, :1])
-    rng = np.random.default_rng(3)
-    scale = lambda s: 1 / np.sqrt(np.prod(s.shape[:-1])) if len(s.shape) > 1 else 0.1  # kernels: 1 / sqrt(fan in)  # noqa: E731
-    params = jax.tree.map(lambda s: (scale(s) * rng.normal(size=(4, *s.shape))).astype(np.float32), shapes)
+    # 4 agents' params drawn on the host (tests/host_params.py: no init program to compile)
+    params = fill_like(jax.eval_shape(network.init, jax.random.key(0), obs[0, :1]), seed=3, batch=(4,))
 
     def grad(p, o):
         return jax.grad(lambda p: jax.nn.log_softmax(network.apply(p, o)).mean())(p)
