@@ -28,7 +28,7 @@ export OCTAX_ROM_DIR ?= ../shared/roms/octax
 
 # Two pytest workers: JAX compiles are CPU-bound and mostly single-threaded, and on 2 cores this cut
 # the suite from ~50 s to ~35 s. loadfile keeps a file's tests, which share compiled functions, in
-# one worker (and tests/train's files together: they share session runs; tests/conftest.py). `make test PYTEST_ARGS=` runs serially; `make bench BENCH_ARGS=--quick` is a smoke test.
+# one worker. `make test PYTEST_ARGS=` runs serially; `make bench BENCH_ARGS=--quick` is a smoke test.
 PYTEST_ARGS ?= -n 2 --dist loadfile
 BENCH_ARGS  ?=
 

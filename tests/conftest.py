@@ -77,46 +77,17 @@ def pytest_configure(config):
         config.option.loadscopereorder = False  # xdist would queue files by test count, not this order
 
 
-# Work units: pytest-xdist's loadfile gives each worker whole files, so a file's tests share its
-# compiled functions. tests/train's files go to one worker together: they read the runs conftest's
-# session fixtures train once per process (the lone and many-agent runs, the multi-task run), so
-# split over two workers those runs would be trained, and compiled, twice.
-_ONE_UNIT_FOLDERS = ("tests/train/",)
-
-
-def work_unit(nodeid: str) -> str:
-    """The unit of work a test belongs to: its file, or a folder of files that share session runs."""
-    file = nodeid.split("::")[0]
-    return next((folder for folder in _ONE_UNIT_FOLDERS if file.startswith(folder)), file)
-
-
-@pytest.hookimpl(optionalhook=True)
-def pytest_xdist_make_scheduler(config, log):
-    if config.getvalue("dist") != "loadfile":
-        return None
-    from xdist.scheduler import LoadFileScheduling
-
-    class LoadUnitScheduling(LoadFileScheduling):
-        def _split_scope(self, nodeid: str) -> str:
-            return work_unit(nodeid)
-
-    return LoadUnitScheduling(config, log)
-
-
 def pytest_collection_modifyitems(config, items):
     seconds = _recorded_file_seconds()
     if not seconds:
         return
-    unit_seconds: collections.Counter = collections.Counter()
     first_seen: dict = {}
-    for file in {item.nodeid.split("::")[0] for item in items}:
-        unit_seconds[work_unit(file)] += float(seconds.get(file, math.inf))  # a new file: its unit first
     for item in items:
-        first_seen.setdefault(work_unit(item.nodeid), len(first_seen))
+        first_seen.setdefault(item.nodeid.split("::")[0], len(first_seen))
 
     def longest_first(item):
-        unit = work_unit(item.nodeid)
-        return -unit_seconds[unit], first_seen[unit]
+        file = item.nodeid.split("::")[0]
+        return -float(seconds.get(file, math.inf)), first_seen[file]
 
     items.sort(key=longest_first)  # stable: a file's tests keep their order
 
