@@ -49,27 +49,18 @@ if os.environ.get("OCTAX_COMPILE_LOG"):
 
 # Longest files first: pytest-xdist hands each worker whole files (`--dist loadfile`) in collection
 # order, so a long file collected last keeps one worker busy while the other waits. Each run records
-# its files' seconds in .cache (controller only, merged with earlier runs' files) and the next run
-# schedules them longest first, new files before all; within a file the order is kept. A fresh
-# clone has no record yet: its first run, the one that compiles everything, is scheduled by
-# tests/file-seconds.json, the seconds of a first run (a hint only: refresh it with
-# `cp .cache/test-file-seconds.json tests/file-seconds.json` after a first run in a fresh clone).
+# its files' seconds here (controller only, merged with earlier runs' files) and the next run
+# schedules them longest first, new files before all; within a file the order is kept.
 _FILE_SECONDS = Path(__file__).resolve().parent.parent / ".cache" / "test-file-seconds.json"
-_FIRST_RUN_SECONDS = Path(__file__).resolve().parent / "file-seconds.json"
 _SECONDS_THIS_RUN: collections.Counter = collections.Counter()
 
 
-def _read_seconds(path: Path) -> dict:
+def _recorded_file_seconds() -> dict:
     try:
-        seconds = json.loads(path.read_text())
+        seconds = json.loads(_FILE_SECONDS.read_text())
     except (OSError, ValueError):
         return {}
     return seconds if isinstance(seconds, dict) else {}
-
-
-def _recorded_file_seconds() -> dict:
-    """This clone's recorded seconds per file, over the committed first-run seconds."""
-    return {**_read_seconds(_FIRST_RUN_SECONDS), **_read_seconds(_FILE_SECONDS)}
 
 
 def pytest_configure(config):
@@ -99,7 +90,7 @@ def pytest_runtest_logreport(report):
 def pytest_sessionfinish(session):
     if hasattr(session.config, "workerinput") or not _SECONDS_THIS_RUN:
         return  # an xdist worker: the controller sees every worker's reports and writes once
-    seconds = {**_read_seconds(_FILE_SECONDS), **{f: round(t, 2) for f, t in _SECONDS_THIS_RUN.items()}}
+    seconds = {**_recorded_file_seconds(), **{f: round(t, 2) for f, t in _SECONDS_THIS_RUN.items()}}
     try:
         _FILE_SECONDS.parent.mkdir(parents=True, exist_ok=True)
         _FILE_SECONDS.write_text(json.dumps(seconds, indent=0, sort_keys=True))
