@@ -122,6 +122,16 @@ def jitted_execute(machine: octax_core.Machine):
     return jax.jit(machine.execute, compiler_options=machine.compiler_options)
 
 
+@pytest.fixture(scope="session", autouse=True)
+def sb3_logs_in_pytest_temp(tmp_path_factory):
+    """Stable-Baselines3's `learn` makes a folder for its logger on every call: SB3_LOGDIR, else a new
+    /tmp/SB3-<time>. The suite's go under pytest's own temp folder, which pytest prunes, instead of
+    piling up in /tmp (the processes the tests start inherit the variable)."""
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setenv("SB3_LOGDIR", str(tmp_path_factory.mktemp("sb3-logs")))
+        yield
+
+
 @pytest.fixture(scope="session")
 def jit_run_frames():
     return jitted_run_frames
