@@ -9,7 +9,9 @@ Three layers, each a subpackage that imports only the ones before it:
 
 The names below are the public API. See docs/machine.md (the machine) and docs/env.md (the envs).
 ``OCTAX_CPU_THREADS`` (read here, before anything else starts JAX) sizes XLA:CPU's thread pool;
-see `octax_core.host`.
+see `octax_core.host`. Importing octax_core also lowers JAX's Threefry hash unrolled on CPU, the
+same bits in fewer kernels, for every program of the process (``OCTAX_ROLLED_THREEFRY=1`` keeps
+JAX's loop); see `octax_core.threefry`.
 
 `__version__` is the installed distribution's (`octax-gym`, whose version pyproject.toml sets):
 read from the package metadata rather than written here too, so there is one number to bump;
@@ -18,7 +20,7 @@ read from the package metadata rather than written here too, so there is one num
 
 from importlib import metadata as _metadata
 
-from octax_core import host
+from octax_core import host, threefry
 
 try:
     __version__ = _metadata.version("octax-gym")
@@ -26,6 +28,7 @@ except _metadata.PackageNotFoundError:  # a source tree on sys.path, never insta
     __version__ = "0+unknown"
 
 host.apply_environment()  # before any import below can start JAX's backends
+threefry.apply_environment()  # before any program is lowered: Threefry unrolled on CPU
 
 
 from octax_core.emulator import (FONT, FONT_ADDRESS, MAX_ROM_SIZE, PLATFORMS, PROGRAM_ADDRESS, QUIRK_PROFILES, Kind,
