@@ -65,7 +65,7 @@ def test_jitted_threefry_on_cpu_is_the_reference_hash():
 def test_the_unrolled_form_is_what_a_cpu_program_compiles():
     """JAX's rolled form is a while loop in the compiled program; the unrolled one is none."""
     split = jax.jit(lambda key: jax.random.split(key, 4)).lower(jax.random.key(0)).compile().as_text()
-    assert " while(" not in split and "while" not in split.lower()
+    assert "while" not in split.lower()
 
 
 DRAWS = """
