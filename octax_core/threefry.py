@@ -7,7 +7,8 @@ each an LLVM module of its own, and an env step draws with it two to four times 
 the sticky action, the autoreset's start). Unrolled, as JAX lowers it on GPU, the rounds are
 adds, rotations and xors that fuse with the code around them, so the env's programs have fewer
 kernels to compile (measured: docs/machine-log.md). The numbers drawn are the same bits: it is
-the same hash in exact uint32 arithmetic, looped or not (tests/core_env/test_threefry.py checks it against a NumPy Threefry-2x32 and JAX's own loop).
+the same hash in exact uint32 arithmetic, looped or not (tests/core_env/test_threefry.py checks
+it against a NumPy Threefry-2x32 and against JAX's own loop).
 
 A lowering rule belongs to the process, not to a program: once `octax_core` is imported, every
 program lowered for the CPU in that process, the user's own among them, hashes with the unrolled
@@ -47,7 +48,7 @@ def threefry2x32(key1, key2, x1, x2):
     return x1, x2
 
 
-_UNROLLED = mlir.lower_fun(lambda key1, key2, x1, x2: threefry2x32(key1, key2, x1, x2), multiple_results=True)
+_UNROLLED = mlir.lower_fun(threefry2x32, multiple_results=True)
 
 
 def install() -> None:
