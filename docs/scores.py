@@ -315,7 +315,7 @@ def write_page(table: dict) -> str:
         "`normalized_score(game_id, score)` = (score - random) / (reference - random), and the "
         "aggregate statistics of Agarwal et al. (2021), \"Deep RL at the edge of the statistical "
         "precipice\": the interquartile mean (IQM) and stratified-bootstrap confidence intervals "
-        "(`iqm`, `stratified_bootstrap_ci`, `aggregate`). Those are written on numpy and scipy: the "
+        "(`iqm`, `stratified_bootstrap_ci`, `aggregate`). Those are written on numpy: the "
         "authors' package, rliable (1.2.0, its last release, August 2024), no longer imports beside "
         "pandas 3 and arch 7.2 (`TypeError: deprecate_kwarg() missing 1 required positional argument`).",
         "",

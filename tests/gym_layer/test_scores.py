@@ -8,6 +8,8 @@ from __future__ import annotations
 import itertools
 import json
 import runpy
+import subprocess
+import sys
 from importlib import resources
 from pathlib import Path
 
@@ -102,6 +104,44 @@ def test_bootstrap_is_a_resample_of_runs_within_each_game():
     assert scores.stratified_bootstrap_ci(matrix, scores.iqm, reps, seed=seed) == \
         scores.stratified_bootstrap_ci(matrix, scores.iqm, reps, seed=seed)
 
+
+
+@pytest.mark.parametrize("shape", [(1, 1), (2, 3), (7, 1), (5, 9), (33, 4)])
+def test_the_bootstrap_of_each_statistic_is_that_statistic_of_each_resample(shape):
+    """The bootstrap computes the paper's four statistics on the whole stack of resamples at once;
+    each value is, to the bit, the statistic of that resample alone (and the IQM scipy's trim_mean,
+    NaN included: a resample with a NaN is NaN, even where the NaN would be trimmed)."""
+    rng = np.random.default_rng(sum(shape))
+    matrix = np.round(rng.normal(size=shape) * 100, 1)  # ties too
+    with_nan = matrix.copy()
+    with_nan.flat[-1] = np.nan
+    reps, seed = 150, 5
+    resamples = matrix[np.random.default_rng(seed).integers(0, shape[0], (reps, *shape)), np.arange(shape[1])]
+    for name, statistic in scores.STATISTICS.items():
+        expected = [statistic(resample) for resample in resamples]
+        assert np.array_equal(scores.bootstrap_distribution(matrix, statistic, reps, seed), expected), name
+    nan_resamples = with_nan[np.random.default_rng(seed).integers(0, shape[0], (reps, *shape)), np.arange(shape[1])]
+    expected = [stats.trim_mean(resample, 0.25, axis=None) for resample in nan_resamples]
+    assert np.array_equal(scores.bootstrap_distribution(with_nan, scores.iqm, reps, seed), expected, equal_nan=True)
+    assert np.isnan(scores.iqm(with_nan))
+
+
+def test_a_statistic_of_ones_own_is_called_on_each_resample():
+    matrix = np.arange(12.0).reshape(4, 3)
+    seen = []
+
+    def spread(resample):
+        seen.append(resample.shape)
+        return float(resample.max() - resample.min())
+
+    distribution = scores.bootstrap_distribution(matrix, spread, reps=20, seed=1)
+    assert seen == [(4, 3)] * 20 and distribution.shape == (20,) and (distribution <= 11).all()
+
+
+def test_scores_imports_no_scipy():
+    """`from scipy import stats` cost a second of every training process's start; numpy does it."""
+    probe = "import sys, octax_gym.scores, octax_gym.train.report; print(sorted(m for m in sys.modules if m.startswith('scipy')))"
+    assert subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True, check=True).stdout == "[]\n"
 
 def test_bootstrap_reaches_exactly_the_enumerated_resamples():
     """2 runs x 2 games: 4 x 4 equally likely resamples; the bootstrap's values are exactly theirs,
