@@ -14,10 +14,10 @@ stratified bootstrap that resamples runs with replacement within each game. Scor
 (1.2.0, August 2024) fails to import beside pandas 3 and arch 7.2 ("TypeError: deprecate_kwarg()
 missing 1 required positional argument"), so these few functions are written here on numpy,
 following the paper's definitions. Each statistic is written once, over a stack of score matrices,
-so that a bootstrap computes all its resamples in a few array operations (a Python call per
-resample made a 2,000-resample interval take most of a second, and a training run's learning curve
-asks for one per game and evaluation); a statistic of one matrix is the same code on a stack of
-none, so both give the same bits.
+so that a bootstrap computes all its resamples in a few array operations instead of a Python call
+each (a training run's learning curve asks for an interval per game at every evaluation; the times
+are in docs/machine-log.md); a statistic of one matrix is the same code on a stack of none, so both
+give the same bits.
 
     >>> from octax_gym import scores
     >>> matrix = np.stack([scores.normalized_score(g, raw[:, j]) for j, g in enumerate(games)], axis=1)
