@@ -105,7 +105,6 @@ def test_bootstrap_is_a_resample_of_runs_within_each_game():
         scores.stratified_bootstrap_ci(matrix, scores.iqm, reps, seed=seed)
 
 
-
 @pytest.mark.parametrize("shape", [(1, 1), (2, 3), (7, 1), (5, 9), (33, 4)])
 def test_the_bootstrap_of_each_statistic_is_that_statistic_of_each_resample(shape):
     """The bootstrap computes the paper's four statistics on the whole stack of resamples at once;
@@ -140,8 +139,10 @@ def test_a_statistic_of_ones_own_is_called_on_each_resample():
 
 def test_scores_imports_no_scipy():
     """`from scipy import stats` cost a second of every training process's start; numpy does it."""
-    probe = "import sys, octax_gym.scores, octax_gym.train.report; print(sorted(m for m in sys.modules if m.startswith('scipy')))"
+    probe = ("import sys, octax_gym.scores, octax_gym.train.report\n"
+             "print(sorted(m for m in sys.modules if m.startswith('scipy')))")
     assert subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True, check=True).stdout == "[]\n"
+
 
 def test_bootstrap_reaches_exactly_the_enumerated_resamples():
     """2 runs x 2 games: 4 x 4 equally likely resamples; the bootstrap's values are exactly theirs,
