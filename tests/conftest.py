@@ -20,6 +20,7 @@ import pytest
 import octax_core
 
 from shared_data import REQUIRE_SHARED, SHARED, TEST_SUITE_DIR, missing_shared, octax_rom_folder
+from work_units import work_unit
 
 # Tests read the octax suite's ROMs from ../shared when it is there (never from git), else from
 # the user data folder that `octax-gym roms install` fills; `make test` sets this too.
@@ -50,7 +51,9 @@ if os.environ.get("OCTAX_COMPILE_LOG"):
 # Longest files first: pytest-xdist hands each worker whole files (`--dist loadfile`) in collection
 # order, so a long file collected last keeps one worker busy while the other waits. Each run records
 # its files' seconds here (controller only, merged with earlier runs' files) and the next run
-# schedules them longest first, new files before all; within a file the order is kept.
+# schedules them longest first, new files before all; within a file the order is kept. Files that
+# share a session's training runs go to one worker as one unit (tests/work_units.py), ordered by
+# their summed seconds.
 _FILE_SECONDS = Path(__file__).resolve().parent.parent / ".cache" / "test-file-seconds.json"
 _SECONDS_THIS_RUN: collections.Counter = collections.Counter()
 
@@ -68,6 +71,20 @@ def pytest_configure(config):
         config.option.loadscopereorder = False  # xdist would queue files by test count, not this order
 
 
+def pytest_xdist_make_scheduler(config, log):
+    """`--dist loadfile`, with the files of one `work_units.work_unit` in one unit; any other
+    mode is xdist's own."""
+    if config.getoption("dist") != "loadfile":
+        return None
+    from xdist.scheduler import LoadFileScheduling
+
+    class LoadFileWithSharedRuns(LoadFileScheduling):
+        def _split_scope(self, nodeid: str) -> str:
+            return work_unit(super()._split_scope(nodeid))
+
+    return LoadFileWithSharedRuns(config, log)
+
+
 def pytest_collection_modifyitems(config, items):
     seconds = _recorded_file_seconds()
     if not seconds:
@@ -76,9 +93,13 @@ def pytest_collection_modifyitems(config, items):
     for item in items:
         first_seen.setdefault(item.nodeid.split("::")[0], len(first_seen))
 
-    def longest_first(item):
+    unit_seconds: collections.Counter = collections.Counter()
+    for file in first_seen:
+        unit_seconds[work_unit(file)] += float(seconds.get(file, math.inf))
+
+    def longest_first(item):  # a unit's files together, at the unit's summed seconds
         file = item.nodeid.split("::")[0]
-        return -float(seconds.get(file, math.inf)), first_seen[file]
+        return -unit_seconds[work_unit(file)], first_seen[file]
 
     items.sort(key=longest_first)  # stable: a file's tests keep their order
 
