@@ -1,7 +1,7 @@
 # make demo   the games table, a random agent's steps/s on Pong, and a video of it (demo-pong.mp4)
 # make test   run the test suite (all but the tests marked slow), then name the 15 slowest: on 2 cores
-#             9 to 15 minutes the first time (520-890 s), 4 to 8 once JAX's compilation cache (.cache/jax) is
-#             warm (241-472 s); the spread is the machine's speed (docs/machine-log.md)
+#             9 to 15 minutes the first time (520-890 s), about 4 to 8 once JAX's compilation cache (.cache/jax) is
+#             warm (234-472 s); the spread is the machine's speed (docs/machine-log.md)
 # make test-slow  the slow tests: every archive game played, long ROM runs (CI runs both)
 # make bench  throughput of the core on Pong, against the octax package (benchmarks/README.md)
 # make bench-scaling  the scaling figure: octax-gym, octax, EnvPool and ale-py Pong against N (docs/scaling.md)
