@@ -103,6 +103,23 @@ def wait_for(driver, script: str, timeout: float = 30.0):
     raise AssertionError(f"timed out waiting for: {script}")
 
 
+def open_page(driver, url: str, timeout: float = 30.0) -> None:
+    """`driver.get(url)`, then waits until the page's script has made `window.octaxPlay`.
+
+    chromedriver can return from `get` before the new document is the one scripts run in (seen
+    once in a loaded suite: `window.octaxPlay` undefined just after `get`), so the page is polled.
+    A page that never runs its script still fails, naming where the browser is and how far it got."""
+    driver.get(url)
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        if driver.execute_script("return typeof window.octaxPlay === 'object'"):
+            return
+        time.sleep(0.05)
+    where = driver.execute_script("return [document.URL, document.readyState, document.title]")
+    raise AssertionError(f"the page's script did not run within {timeout:g} s: at {where[0]!r} "
+                         f"(readyState {where[1]!r}, title {where[2]!r})")
+
+
 def press(driver, key: str, hold: float) -> None:
     from selenium.webdriver.common.action_chains import ActionChains
 
@@ -158,7 +175,7 @@ def canvas_indices(driver, hello: dict) -> np.ndarray:
 def test_play_in_the_browser(browser, recorded, shots):
     handle, session, recorder = recorded
     driver = browser
-    driver.get(handle.url)
+    open_page(driver, handle.url)
     hello = wait_for(driver, "return window.octaxPlay.hello")
     wait_for(driver, "return window.octaxPlay.log.length > 3 && window.octaxPlay.drawn > 3")
     assert hello["game"] == GAME and GAME in driver.title
@@ -256,7 +273,7 @@ def test_two_player_page_seats(browser, shots):
     handle = start_in_thread(session)
     try:
         driver = browser
-        driver.get(handle.url)
+        open_page(driver, handle.url)
         hello = wait_for(driver, "return window.octaxPlay.hello")
         assert [s["name"] for s in hello["seats"]] == ["left paddle", "right paddle"]
         assert hello["players"] == ["human", "scripted", "random"]
