@@ -106,8 +106,9 @@ def wait_for(driver, script: str, timeout: float = 30.0):
 def open_page(driver, url: str, timeout: float = 30.0) -> None:
     """`driver.get(url)`, then waits until the page's script has made `window.octaxPlay`.
 
-    chromedriver can return from `get` before the new document is the one scripts run in (seen
-    once in a loaded suite: `window.octaxPlay` undefined just after `get`), so the page is polled.
+    chromedriver can return from `get` while scripts still run in the browser's first about:blank
+    document (a known race: SeleniumHQ/selenium#1364; seen once in a loaded suite as
+    `window.octaxPlay` undefined just after `get`), so the page is polled.
     A page that never runs its script still fails, naming where the browser is and how far it got."""
     driver.get(url)
     deadline = time.monotonic() + timeout
