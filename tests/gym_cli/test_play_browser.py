@@ -104,16 +104,17 @@ def wait_for(driver, script: str, timeout: float = 30.0):
 
 
 def open_page(driver, url: str, timeout: float = 30.0) -> None:
-    """`driver.get(url)`, then waits until the page's script has made `window.octaxPlay`.
+    """`driver.get(url)`, then waits until `url`'s document has run its script (`window.octaxPlay`).
 
-    chromedriver can return from `get` while scripts still run in the browser's first about:blank
-    document (a known race: SeleniumHQ/selenium#1364; seen once in a loaded suite as
-    `window.octaxPlay` undefined just after `get`), so the page is polled.
-    A page that never runs its script still fails, naming where the browser is and how far it got."""
+    chromedriver can return from `get` while scripts still run in the previous document, the
+    browser's first about:blank or the page before (a known race: SeleniumHQ/selenium#1364; seen
+    once in a loaded suite as `window.octaxPlay` undefined just after `get`), so the page is polled
+    until its own URL answers. A page that never runs its script still fails, naming where the
+    browser is and how far it got."""
     driver.get(url)
     deadline = time.monotonic() + timeout
     while time.monotonic() < deadline:
-        if driver.execute_script("return typeof window.octaxPlay === 'object'"):
+        if driver.execute_script("return document.URL === arguments[0] && typeof window.octaxPlay === 'object'", url):
             return
         time.sleep(0.05)
     where = driver.execute_script("return [document.URL, document.readyState, document.title]")
