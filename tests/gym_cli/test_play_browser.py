@@ -93,10 +93,10 @@ def recorded(tmp_path_factory):
         os.environ["MINARI_DATASETS_PATH"] = before
 
 
-def wait_for(driver, script: str, timeout: float = 30.0):
+def wait_for(driver, script: str, timeout: float = 30.0, *args):
     deadline = time.monotonic() + timeout
     while time.monotonic() < deadline:
-        value = driver.execute_script(script)
+        value = driver.execute_script(script, *args)
         if value:
             return value
         time.sleep(0.05)
@@ -112,14 +112,12 @@ def open_page(driver, url: str, timeout: float = 30.0) -> None:
     until its own URL answers. A page that never runs its script still fails, naming where the
     browser is and how far it got."""
     driver.get(url)
-    deadline = time.monotonic() + timeout
-    while time.monotonic() < deadline:
-        if driver.execute_script("return document.URL === arguments[0] && typeof window.octaxPlay === 'object'", url):
-            return
-        time.sleep(0.05)
-    where = driver.execute_script("return [document.URL, document.readyState, document.title]")
-    raise AssertionError(f"the page's script did not run within {timeout:g} s: at {where[0]!r} "
-                         f"(readyState {where[1]!r}, title {where[2]!r})")
+    try:
+        wait_for(driver, "return document.URL === arguments[0] && typeof window.octaxPlay === 'object'", timeout, url)
+    except AssertionError:
+        where = driver.execute_script("return [document.URL, document.readyState, document.title]")
+        raise AssertionError(f"the page's script did not run within {timeout:g} s: at {where[0]!r} "
+                             f"(readyState {where[1]!r}, title {where[2]!r})") from None
 
 
 def press(driver, key: str, hold: float) -> None:
